@@ -1,0 +1,121 @@
+// warpcheck/core.h: the types every kernel shares.
+//
+// Every kernel in lib/ is templated on its scalar type T (float, double, long double) so the same code can be
+// checked against its own long double instantiation. Every kernel returns a DirectionSample<T>: a unit
+// world-space direction, its density with respect to solid angle, and whether a sample exists at all. A kernel
+// never returns NaN and never throws for bad geometry: it returns "no sample" with a NoSample reason instead.
+#pragma once
+
+#include <Eigen/Core>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <numbers>
+
+namespace warpcheck {
+
+template <class T> using Vec2 = Eigen::Matrix<T, 2, 1>;
+template <class T> using Vec3 = Eigen::Matrix<T, 3, 1>;
+
+// Why a kernel produced no sample. kNone means a sample exists.
+enum class NoSample : std::uint8_t {
+  kNone = 0,
+  kNonFinite,        // NaN or Inf anywhere in the input
+  kBadNormal,        // zero (or non-normalisable) shading normal
+  kZeroSize,         // radius 0, zero-area polygon, ...
+  kNegativeSize,     // negative radius
+  kInsideLight,      // shading point inside the light or on its surface
+  kBelowHorizon,     // the light is entirely behind the shading surface
+  kEdgeOn,           // the light is seen exactly edge-on (zero solid angle)
+  kTooSmall,         // the light subtends no representable solid angle in this precision
+  kOnSilhouette,     // the sample landed where the density is infinite (a measure-zero set)
+  kInvalidGeometry,  // non-convex, non-planar, too many vertices, singular transform, ...
+};
+
+constexpr const char* to_string(NoSample r) {
+  switch (r) {
+    case NoSample::kNone: return "sample";
+    case NoSample::kNonFinite: return "non-finite input";
+    case NoSample::kBadNormal: return "zero or non-finite shading normal";
+    case NoSample::kZeroSize: return "light of zero size";
+    case NoSample::kNegativeSize: return "light of negative size";
+    case NoSample::kInsideLight: return "shading point inside or on the light";
+    case NoSample::kBelowHorizon: return "light entirely below the horizon";
+    case NoSample::kEdgeOn: return "light seen edge-on";
+    case NoSample::kTooSmall: return "light subtends no representable solid angle";
+    case NoSample::kOnSilhouette: return "sample on the silhouette (infinite density)";
+    case NoSample::kInvalidGeometry: return "invalid geometry";
+  }
+  return "unknown";
+}
+
+// The one result type of every kernel.
+template <class T> struct DirectionSample {
+  Vec3<T> direction = Vec3<T>::Zero();  // unit, world space; zero when there is no sample
+  T pdf = T(0);                         // density w.r.t. solid angle; 0 when there is no sample
+  NoSample reason = NoSample::kNone;
+
+  bool valid() const { return reason == NoSample::kNone; }
+  static DirectionSample none(NoSample why) {
+    DirectionSample s;
+    s.reason = why;
+    return s;
+  }
+};
+
+// A point on a surface being shaded. The normal need not be unit length; kernels normalise it.
+template <class T> struct ShadingPoint {
+  Vec3<T> position = Vec3<T>::Zero();
+  Vec3<T> normal = Vec3<T>(T(0), T(0), T(1));
+};
+
+// A spherical cap {w : angle(w, axis) <= half_angle}. Stored with the squared chord length 2(1 - cos) so that
+// tiny caps keep their precision: cos(half_angle) rounds to 1 long before the chord does.
+template <class T> struct Cap {
+  Vec3<T> axis = Vec3<T>(T(0), T(0), T(1));
+  T one_minus_cos = T(2);  // 1 - cos(half_angle), in [0, 2]
+
+  T cos_half_angle() const { return T(1) - one_minus_cos; }
+  T solid_angle() const { return T(2) * std::numbers::pi_v<T> * one_minus_cos; }
+  // Inclusion test by chord length: |w - axis|^2 = 2 (1 - w.axis) <= 2 (1 - cos(half_angle)).
+  bool contains(const Vec3<T>& w, T slack = T(0)) const {
+    return (w - axis).squaredNorm() <= T(2) * one_minus_cos * (T(1) + slack) + slack;
+  }
+};
+
+template <class T> bool all_finite(const Vec3<T>& v) {
+  return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z());
+}
+
+// An orthonormal frame whose z axis is a given unit vector, by the branch-free construction of Duff et al.,
+// "Building an Orthonormal Basis, Revisited", JCGT 6(1), 2017 (their Listing 3, written from the formulas).
+template <class T> struct Frame {
+  Vec3<T> x, y, z;
+
+  static Frame from_z(const Vec3<T>& n) {
+    const T sign = std::copysign(T(1), n.z());
+    const T a = T(-1) / (sign + n.z());
+    const T b = n.x() * n.y() * a;
+    Frame f;
+    f.x = Vec3<T>(T(1) + sign * n.x() * n.x() * a, sign * b, -sign * n.x());
+    f.y = Vec3<T>(b, sign + n.y() * n.y() * a, -n.y());
+    f.z = n;
+    return f;
+  }
+  Vec3<T> to_world(const Vec3<T>& v) const { return v.x() * x + v.y() * y + v.z() * z; }
+  Vec3<T> to_local(const Vec3<T>& v) const { return Vec3<T>(v.dot(x), v.dot(y), v.dot(z)); }
+};
+
+// Normalises a shading normal; returns false for zero, subnormal-length or non-finite normals.
+template <class T> bool normalize_normal(const Vec3<T>& n, Vec3<T>& out) {
+  if (!all_finite(n)) return false;
+  const T len = n.stableNorm();
+  if (!(len > std::numeric_limits<T>::min()) || !std::isfinite(len)) return false;
+  out = n / len;
+  return std::isfinite(out.x()) && std::isfinite(out.y()) && std::isfinite(out.z());
+}
+
+template <class T> constexpr T kPi = std::numbers::pi_v<T>;
+template <class T> constexpr T kTwoPi = T(2) * std::numbers::pi_v<T>;
+
+}  // namespace warpcheck

@@ -1,0 +1,84 @@
+// warpcheck/validation/battery.h: the statistical battery.
+//
+// run_battery(sampler, options) draws options.samples directions with fixed seeds and runs:
+//   chi2          chi-square on an equal-area grid over the sampler's bounding cap; expected counts from
+//                 long double adaptive quadrature of the pdf; low-expected bins pooled; p from
+//                 boost::math::chi_squared. A sample outside the bounding cap, or declined, where the pdf
+//                 gives no mass is impossible under the null hypothesis: p = 0.
+//   ks-radial     Kolmogorov-Smirnov on t = (1 - cos theta) / (1 - cos theta_max) in the cap's frame
+//   ks-azimuth    Kolmogorov-Smirnov on phi / 2 pi in the cap's frame; both CDFs from quadrature of the pdf
+//                 (not renormalised: a pdf that integrates to 1.001 is a wrong CDF), p from
+//                 boost::math::kolmogorov_smirnov_distribution.
+//   pdf-integral  |integral of pdf over the sphere - 1| (deterministic; p_value null)
+//   pdf-consistency  max relative error between a sample's pdf, pdf(direction), and the inverse area element
+//                 of the (reference) warp by 4th-order central differences in long double (deterministic)
+//   normalization:<what>  relative error of each declared Normalization (deterministic)
+// Statistical tests (those with a p-value) are judged together by apply_correction: one significance level
+// alpha for the whole run, Sidak or Holm corrected across all its statistical tests.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "warpcheck/validation/sampler.h"
+
+namespace warpcheck::validation {
+
+enum class Correction { kSidak, kHolm };
+const char* to_string(Correction c);
+
+struct TestResult {
+  std::string kernel, scalar, config, test;
+  double statistic = 0;           // chi2 / KS D / relative error
+  std::optional<double> p_value;  // null for deterministic tests
+  bool passed = false;            // for statistical tests: set by apply_correction
+  std::string detail;             // human-readable: dof, pooled bins, tolerance, worst point, ...
+};
+
+struct BatteryOptions {
+  std::uint64_t samples = 10'000'000;  // per sampler; see README "Choosing the sample count"
+  std::uint64_t seed = 1;
+  int radial_bins = 16, azimuth_bins = 32;  // chi-square grid: 512 equal-area bins over the bounding cap
+  double min_expected = 5;                  // bins expected to hold fewer samples are pooled
+  int ks_cdf_nodes = 8192;                  // nodes of the quadrature-computed marginal CDFs
+  int consistency_points = 2048;            // primary-sample points of the pdf/Jacobian check
+  int threads = 0;                          // 0: hardware concurrency
+  // Called with (phase, fraction done) during long work; may be empty.
+  std::function<void(const std::string&, double)> progress;
+};
+
+// Runs every test of the battery on one sampler. Statistical results come back with passed == false until
+// apply_correction judges them.
+std::vector<TestResult> run_battery(const SamplerUnderTest& s, const BatteryOptions& options);
+
+// Judges every statistical result at family-wise level alpha across all of them (Sidak: each p <= 1 - (1 -
+// alpha)^(1/m); Holm: step-down). Returns the number m of statistical tests.
+std::size_t apply_correction(std::vector<TestResult>& results, double alpha, Correction c);
+
+bool all_passed(const std::vector<TestResult>& results);
+// A fixed-width table: kernel, scalar, config, test, statistic, p-value, verdict.
+std::string format_table(const std::vector<TestResult>& results);
+// {"alpha":..., "correction":..., "statistical_tests": m, "results":[...]}
+std::string to_json(const std::vector<TestResult>& results, double alpha, Correction c);
+
+// Convenience for a user's own GoogleTest: run the battery on one sampler and judge it at alpha.
+std::vector<TestResult> validate(const SamplerUnderTest& s, const BatteryOptions& options = {},
+                                 double alpha = 0.01, Correction c = Correction::kHolm);
+
+// ---- Building blocks, exposed for tests -----------------------------------------------------------------
+
+// Integral of f over the region {w : t in [t0, t1], phi in [phi0, phi1]} of a cap's frame, where
+// t = (1 - cos theta) / cap.one_minus_cos (so t in [0, 1] spans the cap; t up to 2 / one_minus_cos reaches
+// the antipode), by nested adaptive Gauss-Kronrod in long double. Copes with jumps of f inside the region by
+// bisection (Boost's gauss_kronrod with a deep max_depth), to relative accuracy ~tol.
+Real integrate_cap_region(const std::function<Real(const Vec3L&)>& f, const Cap<Real>& cap, Real t0, Real t1,
+                          Real phi0, Real phi1, Real tol = 1e-10L);
+
+// The direction with coordinates (t, phi) in the cap's frame, and back.
+Vec3L cap_direction(const Cap<Real>& cap, Real t, Real phi);
+void cap_coordinates(const Cap<Real>& cap, const Vec3L& w, Real& t, Real& phi);
+
+}  // namespace warpcheck::validation

@@ -1,0 +1,126 @@
+// warpcheck/validation/sampler.h: what the battery tests.
+//
+// The battery runs on a SamplerUnderTest: one sampler bound to one geometry, seen through long double. Two
+// ways to get one:
+//
+//  1. Your own sampler (any precision, any geometry type): fill in the fields by hand with lambdas.
+//     `sample` and `pdf` are required, and so is `bounding_cap`, a spherical cap that contains every
+//     direction the sampler can return (the chi-square grid is laid over it, so make it tight).
+//
+//  2. A kernel type satisfying the `Kernel` concept below (a Scalar, a Geometry, static sample / pdf /
+//     bounding_cap): `bind_kernel<K>(geometry)` builds the SamplerUnderTest, and `bind_kernel<K, KRef>` also
+//     wires KRef (the same kernel in long double) as the reference warp for the Jacobian check.
+//
+// Conventions: directions are unit world-space vectors; densities are with respect to solid angle; a sample
+// with valid == false means the sampler declined (allowed only where the sampler also reports pdf == 0
+// everywhere, i.e. "no sample" geometry; the battery counts declined samples and fails on any).
+#pragma once
+
+#include <concepts>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "warpcheck/core.h"
+
+namespace warpcheck::validation {
+
+using Real = long double;
+using Vec3L = Vec3<long double>;
+
+struct Sample {
+  Vec3L direction = Vec3L::Zero();
+  Real pdf = 0;
+  bool valid = false;
+};
+
+// An independently computed measure that the sampler's normalisation must equal (e.g. the cap's solid angle
+// for a uniform cone sampler, the projected solid angle for a projected-solid-angle sampler).
+struct Normalization {
+  std::string what;                  // e.g. "solid angle of the cap"
+  std::function<Real()> kernel;      // the value the kernel's own code uses (e.g. 1 / pdf)
+  Real reference = 0;                // computed independently of the kernel's code
+};
+
+struct SamplerUnderTest {
+  std::string kernel;  // kernel name, e.g. "sphere-solid-angle"
+  std::string scalar;  // "float", "double", "long double" or whatever the sampler computes in
+  std::string config;  // configuration name, e.g. "near"
+
+  std::function<Sample(double u0, double u1)> sample;  // required
+  std::function<Real(const Vec3L&)> pdf;               // required: density of a unit direction
+  Cap<Real> bounding_cap;                              // required: contains the support
+
+  // Optional: membership in the support, used to flag samples outside the light. Default: pdf(w) > 0.
+  std::function<bool(const Vec3L&)> in_support;
+  // Optional: the same warp evaluated in higher precision, for the Jacobian check. Default: `sample`.
+  std::function<Sample(Real u0, Real u1)> reference_sample;
+  // Documented kinks of the warp in primary sample space: the Jacobian check skips points whose
+  // finite-difference stencil would straddle one. Periodic seams (u = 0 or 1) need not be listed.
+  std::vector<Real> kinks_u0, kinks_u1;
+  // Optional independent normalisation checks.
+  std::vector<Normalization> normalizations;
+  // Relative tolerance of the deterministic checks (pdf consistency, integral, normalisation). The
+  // issue's 1e-6 for double and long double; a float sampler states its own, measured, tolerance.
+  Real tolerance = 1e-6L;
+  // Why the tolerance differs from 1e-6, if it does (printed in the JSON results).
+  std::string tolerance_note;
+};
+
+// ---- Kernel concept: for samplers written as warpcheck-style kernels ---------------------------------------
+
+template <class K>
+concept Kernel = requires(const typename K::Geometry& g, typename K::Scalar u,
+                          const Vec3<typename K::Scalar>& w) {
+  typename K::Scalar;
+  typename K::Geometry;
+  { K::sample(g, Vec2<typename K::Scalar>(u, u)) } -> std::convertible_to<DirectionSample<typename K::Scalar>>;
+  { K::pdf(g, w) } -> std::convertible_to<typename K::Scalar>;
+  { K::bounding_cap(g) } -> std::convertible_to<Cap<typename K::Scalar>>;
+};
+
+template <class T> Vec3L to_long(const Vec3<T>& v) { return v.template cast<Real>(); }
+
+template <class T> constexpr const char* scalar_name() {
+  if constexpr (std::is_same_v<T, float>) return "float";
+  else if constexpr (std::is_same_v<T, double>) return "double";
+  else if constexpr (std::is_same_v<T, long double>) return "long double";
+  else return "custom";
+}
+
+template <class T> Sample to_sample(const DirectionSample<T>& s) {
+  return Sample{to_long(s.direction), Real(s.pdf), s.valid()};
+}
+
+// Binds kernel K to geometry g. The geometry is converted to K's scalar type by the caller.
+template <Kernel K> SamplerUnderTest bind_kernel(std::string kernel, std::string config,
+                                                 const typename K::Geometry& g) {
+  using T = typename K::Scalar;
+  SamplerUnderTest s;
+  s.kernel = std::move(kernel);
+  s.config = std::move(config);
+  s.scalar = scalar_name<T>();
+  s.sample = [g](double u0, double u1) { return to_sample(K::sample(g, Vec2<T>(T(u0), T(u1)))); };
+  s.pdf = [g](const Vec3L& w) { return Real(K::pdf(g, w.template cast<T>())); };
+  const Cap<T> cap = K::bounding_cap(g);
+  s.bounding_cap = Cap<Real>{to_long(cap.axis).normalized(), Real(cap.one_minus_cos)};
+  return s;
+}
+
+// As above, with KRef (the same kernel in long double, on the same geometry converted) as the reference warp.
+template <Kernel K, Kernel KRef>
+SamplerUnderTest bind_kernel(std::string kernel, std::string config, const typename K::Geometry& g,
+                             const typename KRef::Geometry& g_ref) {
+  SamplerUnderTest s = bind_kernel<K>(std::move(kernel), std::move(config), g);
+  s.reference_sample = [g_ref](Real u0, Real u1) {
+    using R = typename KRef::Scalar;
+    return to_sample(KRef::sample(g_ref, Vec2<R>(R(u0), R(u1))));
+  };
+  // The bounding cap from the long double geometry is tighter for tiny lights in float.
+  const auto cap = KRef::bounding_cap(g_ref);
+  s.bounding_cap = Cap<Real>{to_long(cap.axis).normalized(), Real(cap.one_minus_cos)};
+  return s;
+}
+
+}  // namespace warpcheck::validation
