@@ -50,7 +50,7 @@ template <class T> SphereView<T> make_sphere_view(const SphereLightGeometry<T>& 
   const Vec3<T>& x = g.shading.position;
   const Vec3<T>& c = g.light.center;
   const T r = g.light.radius;
-  if (!all_finite(x) || !all_finite(c) || !std::isfinite(r)) return v.reason = NoSample::kNonFinite, v;
+  if (!all_finite(x) || !all_finite(c) || !all_finite(g.shading.normal) || !std::isfinite(r)) return v.reason = NoSample::kNonFinite, v;
   if (!normalize_normal(g.shading.normal, v.normal)) return v.reason = NoSample::kBadNormal, v;
   if (r < T(0)) return v.reason = NoSample::kNegativeSize, v;
   if (r == T(0)) return v.reason = NoSample::kZeroSize, v;

@@ -39,6 +39,7 @@ Registry default_registry() {
   Registry r;
   // One line per kernel family.
   register_sphere_kernels(r);
+  register_polygon_kernels(r);
   return r;
 }
 

@@ -36,6 +36,7 @@ struct TestResult {
   std::optional<double> p_value;  // null for deterministic tests
   bool passed = false;            // for statistical tests: set by apply_correction
   std::string detail;             // human-readable: dof, pooled bins, tolerance, worst point, ...
+  std::string known_limitation;   // non-empty: a documented expected failure; it does not fail a run
 };
 
 struct BatteryOptions {
@@ -58,11 +59,14 @@ std::vector<TestResult> run_battery(const SamplerUnderTest& s, const BatteryOpti
 // alpha)^(1/m); Holm: step-down). Returns the number m of statistical tests.
 std::size_t apply_correction(std::vector<TestResult>& results, double alpha, Correction c);
 
+// True when every result passed or is a documented known limitation.
 bool all_passed(const std::vector<TestResult>& results);
 // A fixed-width table: kernel, scalar, config, test, statistic, p-value, verdict.
 std::string format_table(const std::vector<TestResult>& results);
-// {"alpha":..., "correction":..., "statistical_tests": m, "results":[...]}
-std::string to_json(const std::vector<TestResult>& results, double alpha, Correction c);
+// {"alpha":..., "correction":..., "statistical_tests": m, <extra_members>, "results":[...]}; extra_members is
+// raw JSON ("\"seed\":1,\"samples\":10") inserted as is.
+std::string to_json(const std::vector<TestResult>& results, double alpha, Correction c,
+                    const std::string& extra_members = "");
 
 // Convenience for a user's own GoogleTest: run the battery on one sampler and judge it at alpha.
 std::vector<TestResult> validate(const SamplerUnderTest& s, const BatteryOptions& options = {},

@@ -47,5 +47,6 @@ Registry default_registry();
 
 // Registrars, one per kernel family.
 void register_sphere_kernels(Registry& r);
+void register_polygon_kernels(Registry& r);
 
 }  // namespace warpcheck::validation

@@ -16,6 +16,7 @@
 // everywhere, i.e. "no sample" geometry; the battery counts declined samples and fails on any).
 #pragma once
 
+#include <cmath>
 #include <concepts>
 #include <functional>
 #include <optional>
@@ -66,6 +67,9 @@ struct SamplerUnderTest {
   Real tolerance = 1e-6L;
   // Why the tolerance differs from 1e-6, if it does (printed in the JSON results).
   std::string tolerance_note;
+  // Geometry for which the sampler must decline every sample (e.g. a light entirely below the horizon):
+  // the battery then checks only that every sample is declined and the pdf is zero everywhere.
+  bool expect_no_sample = false;
 };
 
 // ---- Kernel concept: for samplers written as warpcheck-style kernels ---------------------------------------
@@ -89,6 +93,13 @@ template <class T> constexpr const char* scalar_name() {
   else return "custom";
 }
 
+// A uniform number in [0, 1) as T: rounding to float can turn 1 - 2^-53 into 1, which some warps map onto a
+// measure-zero set of infinite density (a silhouette); keep it below 1.
+template <class T> T to_unit(double u) {
+  const T v = T(u);
+  return v < T(1) ? v : std::nextafter(T(1), T(0));
+}
+
 template <class T> Sample to_sample(const DirectionSample<T>& s) {
   return Sample{to_long(s.direction), Real(s.pdf), s.valid()};
 }
@@ -101,7 +112,7 @@ template <Kernel K> SamplerUnderTest bind_kernel(std::string kernel, std::string
   s.kernel = std::move(kernel);
   s.config = std::move(config);
   s.scalar = scalar_name<T>();
-  s.sample = [g](double u0, double u1) { return to_sample(K::sample(g, Vec2<T>(T(u0), T(u1)))); };
+  s.sample = [g](double u0, double u1) { return to_sample(K::sample(g, Vec2<T>(to_unit<T>(u0), to_unit<T>(u1)))); };
   s.pdf = [g](const Vec3L& w) { return Real(K::pdf(g, w.template cast<T>())); };
   const Cap<T> cap = K::bounding_cap(g);
   s.bounding_cap = Cap<Real>{to_long(cap.axis).normalized(), Real(cap.one_minus_cos)};

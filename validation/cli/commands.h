@@ -1,0 +1,28 @@
+#pragma once
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace warpcheck::cli {
+
+// Bad arguments: main prints the message and exits with status 2.
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct Command {
+  const char* name;
+  const char* summary;
+  int (*main)(const std::vector<std::string>& args);
+};
+
+int list_main(const std::vector<std::string>& args);
+int validate_main(const std::vector<std::string>& args);
+
+// Argument helpers shared by the subcommands.
+std::uint64_t parse_u64(const std::string& flag, const std::string& value, std::uint64_t min, std::uint64_t max);
+double parse_double(const std::string& flag, const std::string& value, double min, double max);
+// Writes text to path atomically (temporary file in the same directory, then rename).
+void write_file_atomically(const std::string& path, const std::string& text);
+
+}  // namespace warpcheck::cli
