@@ -1,0 +1,318 @@
+// warpcheck/polygon.h: convex planar polygon lights: geometry, validation, clipping, bounding caps and the
+// independent long double references (projected solid angle by Lambert's edge formula, solid angle by van
+// Oosterom & Strackee 1983).
+//
+// The sampling kernels live in one header per technique, as the house rule asks one header per light shape
+// and the polygon has several published techniques whose code shares nothing but this geometry:
+//   polygon_projected.h    Peters 2021, Section 3 (projected solid angle) and Section 6.4 (biased variant)
+//   polygon_solid_angle.h  Peters 2021, Section 5 (solid angle, plain and clipped), and the published
+//                          polygon baselines Arvo 1995 (spherical triangles, as a fan) and Turk 1992 (area)
+//   spherical_rectangle.h  Urena et al. 2013 (rectangles only)
+//
+// Conventions. A polygon has 3 to 8 vertices in world space, in either winding, and must be planar and
+// convex. check_polygon() is the validating constructor's test: it returns kInvalidGeometry (and a message)
+// for anything else. Every kernel calls it, so no kernel ever samples invalid input.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <initializer_list>
+#include <string>
+
+#include "warpcheck/core.h"
+
+namespace warpcheck {
+
+inline constexpr int kMaxPolygonVertices = 8;
+// Clipping a convex polygon to a half-space adds at most one vertex.
+inline constexpr int kMaxClippedVertices = kMaxPolygonVertices + 1;
+
+template <class T> struct PolygonLight {
+  std::array<Vec3<T>, kMaxPolygonVertices> vertices{};
+  int count = 0;
+
+  PolygonLight() { vertices.fill(Vec3<T>::Zero()); }
+  PolygonLight(std::initializer_list<Vec3<T>> vs) {
+    vertices.fill(Vec3<T>::Zero());
+    for (const auto& v : vs) {
+      if (count < kMaxPolygonVertices) vertices[count] = v;
+      ++count;  // may exceed the maximum: check_polygon() then rejects it
+    }
+  }
+  template <class U> PolygonLight<U> cast() const {
+    PolygonLight<U> p;
+    p.count = count;
+    for (int i = 0; i < std::min(count, kMaxPolygonVertices); ++i) p.vertices[i] = vertices[i].template cast<U>();
+    return p;
+  }
+};
+
+template <class T> struct PolygonLightGeometry {
+  ShadingPoint<T> shading;
+  PolygonLight<T> light;
+
+  template <class U> PolygonLightGeometry<U> cast() const {
+    return {ShadingPoint<U>{shading.position.template cast<U>(), shading.normal.template cast<U>()},
+            light.template cast<U>()};
+  }
+};
+
+// ---- Small numerical helpers ------------------------------------------------------------------------------
+
+// a d - b c by Kahan's algorithm with fused multiply-adds: accurate to a few ulps and with the correct sign
+// (Jeannerod, Louvet & Muller 2013), which Peters 2021 Sec. 3.7 relies on for short edges.
+template <class T> T kahan_det(T a, T b, T c, T d) {
+  const T w = b * c;
+  const T e = std::fma(-b, c, w);  // the rounding error of b c, exactly
+  const T f = std::fma(a, d, -w);
+  return f + e;
+}
+
+// Cross product with every entry by kahan_det (Peters 2021 Sec. 3.7: cancellation-free edge normals).
+template <class T> Vec3<T> kahan_cross(const Vec3<T>& a, const Vec3<T>& b) {
+  return Vec3<T>(kahan_det(a.y(), a.z(), b.y(), b.z()), kahan_det(a.z(), a.x(), b.z(), b.x()),
+                 kahan_det(a.x(), a.y(), b.x(), b.y()));
+}
+
+// z component of a x b for 2D vectors, by Kahan.
+template <class T> T kahan_cross2(const Vec2<T>& a, const Vec2<T>& b) {
+  return kahan_det(a.x(), a.y(), b.x(), b.y());
+}
+
+// Normalises without overflow or underflow (scales by the largest entry first); zero stays zero.
+template <class T> Vec3<T> safe_normalized(const Vec3<T>& v) {
+  const T m = v.cwiseAbs().maxCoeff();
+  if (!(m > T(0)) || !std::isfinite(m)) return Vec3<T>::Zero();
+  const Vec3<T> s = v / m;
+  return s / s.norm();
+}
+
+// ---- Validation (the validating constructor) -------------------------------------------------------------
+
+// Newell's normal of the polygon (twice its vector area for a planar polygon), from vertex differences so
+// that a small polygon far from the origin keeps its precision.
+template <class T> Vec3<T> polygon_area_vector(const PolygonLight<T>& p) {
+  Vec3<T> n = Vec3<T>::Zero();
+  for (int i = 1; i + 1 < p.count; ++i)
+    n += kahan_cross<T>(p.vertices[i] - p.vertices[0], p.vertices[i + 1] - p.vertices[0]);
+  return n;  // = 2 * area * unit normal (right-hand rule)
+}
+
+// kNone for a valid light; otherwise kNonFinite, kZeroSize or kInvalidGeometry, with a message if asked.
+template <class T> NoSample check_polygon(const PolygonLight<T>& p, std::string* message = nullptr) {
+  auto fail = [&](NoSample r, const char* why) {
+    if (message) *message = why;
+    return r;
+  };
+  if (p.count < 3) return fail(NoSample::kInvalidGeometry, "a polygon needs at least 3 vertices");
+  if (p.count > kMaxPolygonVertices) return fail(NoSample::kInvalidGeometry, "more than 8 vertices");
+  for (int i = 0; i < p.count; ++i)
+    if (!all_finite(p.vertices[i])) return fail(NoSample::kNonFinite, "non-finite vertex");
+  T diameter = 0, magnitude = 0;
+  for (int i = 0; i < p.count; ++i) {
+    magnitude = std::max(magnitude, p.vertices[i].cwiseAbs().maxCoeff());
+    for (int j = i + 1; j < p.count; ++j) diameter = std::max(diameter, (p.vertices[i] - p.vertices[j]).norm());
+  }
+  for (int i = 0; i < p.count; ++i)
+    if (p.vertices[i] == p.vertices[(i + 1) % p.count])
+      return fail(NoSample::kInvalidGeometry, "two consecutive vertices coincide");
+  const Vec3<T> area2 = polygon_area_vector(p);
+  const T area2_norm = area2.norm();
+  if (!(area2_norm > T(0)) || !std::isfinite(area2_norm)) return fail(NoSample::kZeroSize, "zero area");
+  const Vec3<T> nhat = area2 / area2_norm;
+  // Tolerances: input rounding of coordinates of size `magnitude` moves a vertex by ~eps magnitude; beyond
+  // that we allow sqrt(eps) of the diameter (a clearly non-planar or reflex polygon exceeds it by far).
+  const T eps = std::numeric_limits<T>::epsilon();
+  const T tol = T(8) * std::sqrt(eps) * diameter + T(64) * eps * magnitude;
+  for (int i = 0; i < p.count; ++i)
+    if (std::abs(nhat.dot(p.vertices[i] - p.vertices[0])) > tol)
+      return fail(NoSample::kInvalidGeometry, "vertices are not coplanar");
+  // Convexity: every turn goes the same way as the area vector, and the turns add up to one revolution
+  // (rejects star polygons such as a pentagram, whose turns all agree but add up to two).
+  T turning = 0;
+  for (int i = 0; i < p.count; ++i) {
+    const Vec3<T> a = p.vertices[i] - p.vertices[(i + p.count - 1) % p.count];
+    const Vec3<T> b = p.vertices[(i + 1) % p.count] - p.vertices[i];
+    const T s = nhat.dot(kahan_cross<T>(a, b)), c = a.dot(b);
+    if (s < -tol * (a.norm() + b.norm())) return fail(NoSample::kInvalidGeometry, "polygon is not convex");
+    turning += std::atan2(s, c);
+  }
+  if (std::abs(turning - kTwoPi<T>) > T(0.5)) return fail(NoSample::kInvalidGeometry, "polygon is not simple");
+  if (message) message->clear();
+  return NoSample::kNone;
+}
+
+// ---- Clipping to the upper hemisphere (Peters 2021 Sec. 3.1; Supplement A.1 is not available to us) --------
+
+// A polygon of directions in a local frame (vertices need not be unit length; only their directions count).
+template <class T> struct LocalPolygon {
+  std::array<Vec3<T>, kMaxClippedVertices> v;
+  int count = 0;
+  LocalPolygon() { v.fill(Vec3<T>::Zero()); }
+};
+
+// Sutherland-Hodgman against the half-space z >= 0, derived here: keep vertices with z >= 0 and insert the
+// crossing point where an edge changes side. The crossing of p (z > 0) and q (z < 0) is
+// (q_z p - p_z q) / (q_z - p_z): the denominator adds two magnitudes (no cancellation), and we set its z to
+// exactly 0. It lies on the segment, so it lies on the edge's great circle: edge normals of clipped edges are
+// parallel to the originals. A convex polygon gains at most one vertex.
+template <class T> LocalPolygon<T> clip_to_upper_hemisphere(const LocalPolygon<T>& in) {
+  LocalPolygon<T> out;
+  for (int i = 0; i < in.count; ++i) {
+    const Vec3<T>& p = in.v[i];
+    const Vec3<T>& q = in.v[(i + 1) % in.count];
+    const bool p_in = p.z() >= T(0), q_in = q.z() >= T(0);
+    if (p_in && out.count < kMaxClippedVertices) out.v[out.count++] = p;
+    if (p_in != q_in && p.z() != T(0) && q.z() != T(0) && out.count < kMaxClippedVertices) {
+      const T d = q.z() - p.z();
+      Vec3<T> x = (q.z() * p - p.z() * q) / d;
+      x.z() = T(0);
+      out.v[out.count++] = x;
+    }
+  }
+  return out;
+}
+
+// ---- The polygon seen from a shading point (shared by all polygon kernels) ----------------------------------
+
+template <class T> struct PolygonView {
+  NoSample reason = NoSample::kNone;
+  Vec3<T> normal = Vec3<T>::Zero();  // unit shading normal
+  Frame<T> frame = Frame<T>::from_z(Vec3<T>(T(0), T(0), T(1)));  // z: the shading normal
+  Vec3<T> plane_normal = Vec3<T>::Zero();  // unit right-hand normal of the vertex order
+  T plane_distance = 0;    // plane_normal . (V_0 - x): > 0 when the vertex order winds positively seen from x
+  LocalPolygon<T> local;   // V_k - x in the shading frame, not clipped
+  bool valid() const { return reason == NoSample::kNone; }
+};
+
+// Validates the input and expresses the polygon in the shading frame. Edge-on (x in the plane of the light,
+// which includes x on the light) gives kEdgeOn.
+template <class T> PolygonView<T> make_polygon_view(const PolygonLightGeometry<T>& g) {
+  PolygonView<T> v;
+  if (!all_finite(g.shading.position)) return v.reason = NoSample::kNonFinite, v;
+  if (!all_finite(g.shading.normal)) return v.reason = NoSample::kNonFinite, v;
+  if (const NoSample r = check_polygon(g.light); r != NoSample::kNone) return v.reason = r, v;
+  if (!normalize_normal(g.shading.normal, v.normal)) return v.reason = NoSample::kBadNormal, v;
+  v.frame = Frame<T>::from_z(v.normal);
+  v.plane_normal = safe_normalized(polygon_area_vector(g.light));
+  // Signed distance from the centroid (averaging reduces the rounding of a single vertex).
+  Vec3<T> centroid = Vec3<T>::Zero();
+  for (int i = 0; i < g.light.count; ++i) centroid += g.light.vertices[i] - g.shading.position;
+  centroid /= T(g.light.count);
+  if (!all_finite(centroid)) return v.reason = NoSample::kNonFinite, v;
+  v.plane_distance = v.plane_normal.dot(centroid);
+  if (!(v.plane_distance != T(0))) return v.reason = NoSample::kEdgeOn, v;
+  v.local.count = g.light.count;
+  for (int i = 0; i < g.light.count; ++i) v.local.v[i] = v.frame.to_local(Vec3<T>(g.light.vertices[i] - g.shading.position));
+  return v;
+}
+
+// ---- Bounding caps ---------------------------------------------------------------------------------------
+
+// A small cap containing the convex spherical polygon spanned by the given directions (a cap of half-angle
+// below 90 degrees is convex, so containing the vertices suffices). The axis starts at the normalised mean
+// and is refined by a few steps of Badoiu-Clarkson (move towards the farthest vertex by a shrinking step),
+// keeping the best; the radius is measured by chord length so that tiny caps keep their precision. A relative
+// slack of 64 eps covers the rounding of the vertices' normalisation.
+template <class T> Cap<T> bounding_cap_of_directions(const Vec3<T>* dirs, int n) {
+  std::array<Vec3<T>, kMaxClippedVertices> u;
+  Vec3<T> mean = Vec3<T>::Zero();
+  for (int i = 0; i < n; ++i) mean += (u[i] = safe_normalized(dirs[i]));
+  auto radius2 = [&](const Vec3<T>& axis, int* far) {
+    T r = 0;
+    for (int i = 0; i < n; ++i) {
+      const T d = (u[i] - axis).squaredNorm();
+      if (d >= r) r = d, *far = i;
+    }
+    return r;
+  };
+  Vec3<T> axis = safe_normalized(mean);
+  if (axis.isZero()) return Cap<T>{};  // directions cancel: the whole sphere
+  int far = 0;
+  T best = radius2(axis, &far);
+  Vec3<T> best_axis = axis;
+  for (int k = 1; k <= 24; ++k) {
+    axis = safe_normalized(Vec3<T>(axis + (u[far] - axis) / T(k + 1)));
+    const T r = radius2(axis, &far);
+    if (r < best) best = r, best_axis = axis;
+  }
+  radius2(best_axis, &far);
+  const T one_minus_cos = std::min(T(2), best / T(2) * (T(1) + T(64) * std::numeric_limits<T>::epsilon()));
+  return Cap<T>{best_axis, one_minus_cos};
+}
+
+// ---- Independent references (long double) ---------------------------------------------------------------
+//
+// These share no code with the kernels beyond the PolygonLight type: their own clipping, their own frames.
+
+// The polygon as directions from x in a frame whose z axis is the unit normal n, clipped to z >= 0 by
+// parametric intersection (a different formula from clip_to_upper_hemisphere).
+inline int reference_clipped_local(const PolygonLightGeometry<long double>& g, Vec3<long double>* out) {
+  using L = long double;
+  const Vec3<L> n = g.shading.normal.normalized();
+  const Vec3<L> helper = std::abs(n.x()) < L(0.6) ? Vec3<L>(1, 0, 0) : Vec3<L>(0, 1, 0);
+  const Vec3<L> ex = (helper - helper.dot(n) * n).normalized(), ey = n.cross(ex);
+  const int m = g.light.count;
+  Vec3<L> loc[kMaxPolygonVertices];
+  for (int i = 0; i < m; ++i) {
+    const Vec3<L> d = g.light.vertices[i] - g.shading.position;
+    loc[i] = Vec3<L>(d.dot(ex), d.dot(ey), d.dot(n));
+  }
+  int k = 0;
+  for (int i = 0; i < m; ++i) {
+    const Vec3<L>& a = loc[i];
+    const Vec3<L>& b = loc[(i + 1) % m];
+    if (a.z() >= 0) out[k++] = a;
+    if ((a.z() > 0 && b.z() < 0) || (a.z() < 0 && b.z() > 0)) {
+      const L t = a.z() / (a.z() - b.z());
+      Vec3<L> c = a + t * (b - a);
+      c.z() = 0;
+      out[k++] = c;
+    }
+  }
+  return k;
+}
+
+// Projected solid angle (the cosine-weighted solid angle, integral of max(0, n.w) dw) of the polygon seen from
+// the shading point, by Lambert's formula for polygons: (1/2) sum_j gamma_j (n . m_j), where gamma_j is the
+// angle subtended by edge j and m_j the unit normal of the plane through x and edge j, oriented inwards.
+inline long double reference_projected_solid_angle(const PolygonLightGeometry<long double>& g) {
+  using L = long double;
+  Vec3<L> c[kMaxClippedVertices];
+  const int k = reference_clipped_local(g, c);
+  if (k < 3) return 0;
+  L sum = 0;
+  for (int j = 0; j < k; ++j) {
+    const Vec3<L> a = c[j].normalized(), b = c[(j + 1) % k].normalized();
+    const Vec3<L> m = a.cross(b);
+    const L s = m.norm();
+    if (s == 0) continue;
+    const L gamma = std::atan2(s, a.dot(b));
+    sum += gamma * m.z() / s;
+  }
+  return std::abs(sum) / 2;  // the sign is the polygon's winding as seen from x
+}
+
+// Solid angle of the whole polygon (not clipped) by van Oosterom & Strackee 1983 on a fan from vertex 0:
+// tan(Omega / 2) = det(a, b, c) / (1 + a.b + a.c + b.c) for unit a, b, c.
+inline long double reference_solid_angle(const PolygonLightGeometry<long double>& g, bool clipped = false) {
+  using L = long double;
+  Vec3<L> c[kMaxClippedVertices];
+  int k = 0;
+  if (clipped) {
+    k = reference_clipped_local(g, c);
+  } else {
+    for (int i = 0; i < g.light.count; ++i) c[k++] = g.light.vertices[i] - g.shading.position;
+  }
+  if (k < 3) return 0;
+  L sum = 0;
+  const Vec3<L> a = c[0].normalized();
+  for (int j = 1; j + 1 < k; ++j) {
+    const Vec3<L> b = c[j].normalized(), d = c[j + 1].normalized();
+    sum += 2 * std::atan2(a.dot(b.cross(d)), 1 + a.dot(b) + a.dot(d) + b.dot(d));
+  }
+  return std::abs(sum);
+}
+
+}  // namespace warpcheck

@@ -1,0 +1,386 @@
+// warpcheck/polygon_projected.h: projected-solid-angle sampling of convex polygons, Peters 2021 Section 3,
+// and its biased variant (Section 6.4).
+//
+// Density: pdf(w) = cos(theta) / A_Sigma inside the polygon (clipped to the upper hemisphere), where A_Sigma
+// is the polygon's projected solid angle, computed by the kernel as the sum of its sector areas (Eq. 1).
+//
+// Outline (Sec. 3.1-3.4). The polygon is expressed in the shading frame, its y coordinates flipped if its
+// vertex order winds negatively as seen from the shading point (Sec. 3.1), and clipped to z >= 0. Edge j has
+// the great-circle normal n_j = v_j x v_{j+1} (Kahan's determinants, Sec. 3.7); with this winding all n_j
+// point into the polygon and the xy-projection of the polygon runs counterclockwise, so n_{j,z} > 0 marks an
+// outer edge and n_{j,z} < 0 an inner one (Sec. 3.7). Rays through the vertices cut the unit disk into
+// sectors (Fig. 3). A sector is chosen in proportion to its area, then the azimuth inside it is found in
+// closed form (central case, Sec. 3.2) or by the tangent-line iteration (decentral case, Sec. 3.3, Eq. 5-7)
+// from the two-quad initialisation (Sec. 3.4), and the radius in closed form.
+//
+// Homogeneous ellipses (our derivation; Supplement A.2 is not available to us). The paper stores
+// u_j = n_{j,xy} / n_{j,z} and C_j = I + u_j u_j^T, which is infinite in the zenith case n_{j,z} = 0. We store
+// the unit normal n_j instead and work with the scaled matrix Ct_j := n_{j,z}^2 C_j = n_{j,z}^2 I +
+// n_{j,xy} n_{j,xy}^T, which is finite (|Ct_j| = n_{j,z}^2 for unit n_j). Every formula is rewritten with it:
+//   Eq. 1:    area = |n_z| / 2 * atan2(|n_z| s0 x s1, s0^T Ct s1)      (since sqrt|C| = 1 / |n_z|)
+//   Eq. 3:    1 / (w^T C w) = n_z^2 / (w^T Ct w)
+//   Eq. 5:    multiplied by n_{i,z}^2 n_{o,z}^2 > 0, which leaves its roots unchanged:
+//             T = R w_n (n_{o,z}^2 w_n^T Ct_i - n_{i,z}^2 w_n^T Ct_o) - 2 A_delta Ct_i w_n w_n^T Ct_o
+// A zenith edge then simply has area 0 in every sector and radius 0, which is what its degenerate ellipse (a
+// segment through the origin) encloses; no branch is needed.
+//
+// Vertex sorting (Sec. 3.7). The GPU code sorts with bitonic sorting networks to avoid register spilling.
+// On the CPU there is no such concern, so we use the structure directly: the polygon is convex and, in the
+// decentral case, does not surround the zenith, so its vertices' azimuths rise along the outer chain (edges
+// with n_z > 0) and fall along the inner chain (n_z < 0). Starting at the clockwise end, we merge the two
+// monotonic chains like the merge step of merge sort. That is a correct sort (a merge of two sorted lists)
+// in O(m), and it pairs every sector with its inner and outer edge as a by-product. The comparisons are
+// Kahan cross products, the same computation as n_{j,z}, so sorting and edge classification agree (Sec. 3.7).
+#pragma once
+
+#include "warpcheck/polygon.h"
+
+namespace warpcheck {
+
+// ---- arctangents -------------------------------------------------------------------------------------------
+
+// The biased variant's atan2 (Sec. 6.4 asks for a piecewise polynomial with forward error <= 1.2e-5 rad).
+// We reduce to atan on [0, 1] by octant symmetry and use the odd degree-9 polynomial of Abramowitz & Stegun
+// 4.4.47 (Hastings), whose error bound there is 1e-5; test_polygon measures the actual maximum.
+template <class T> T atan2_approx(T y, T x) {
+  const T ax = std::abs(x), ay = std::abs(y);
+  const T hi = std::max(ax, ay), lo = std::min(ax, ay);
+  if (!(hi > T(0))) return T(0);
+  const T t = lo / hi, t2 = t * t;
+  T r = t * (T(0.9998660L) +
+             t2 * (T(-0.3302995L) + t2 * (T(0.1801410L) + t2 * (T(-0.0851330L) + t2 * T(0.0208351L)))));
+  if (ay > ax) r = kPi<T> / 2 - r;
+  if (x < T(0)) r = kPi<T> - r;
+  return std::signbit(y) ? -r : r;
+}
+
+template <class T, bool kBiased> T polygon_atan2(T y, T x) {
+  if constexpr (kBiased) return atan2_approx(y, x);
+  else return std::atan2(y, x);
+}
+
+// ---- Ellipses in homogeneous form ------------------------------------------------------------------------
+
+template <class T> struct EdgeEllipse {
+  Vec2<T> nxy = Vec2<T>::Zero();  // xy part of the unit edge normal
+  T nz = 0;                       // z part; 0 in the zenith case
+
+  T c() const { return nz * nz; }
+  // a^T Ct b with Ct = nz^2 I + nxy nxy^T.
+  T form(const Vec2<T>& a, const Vec2<T>& b) const { return nz * nz * a.dot(b) + nxy.dot(a) * nxy.dot(b); }
+  Vec2<T> times(const Vec2<T>& a) const { return nz * nz * a + nxy * nxy.dot(a); }  // Ct a
+  // 1 / (w^T C w): the ray through w meets the ellipse at w / sqrt(w^T C w) (Eq. 3).
+  T inverse_quadratic(const Vec2<T>& w) const {
+    const T f = form(w, w);
+    return f > T(0) ? nz * nz / f : T(0);
+  }
+};
+
+template <class T> EdgeEllipse<T> edge_ellipse(const Vec3<T>& n_unit) {
+  return EdgeEllipse<T>{Vec2<T>(n_unit.x(), n_unit.y()), n_unit.z()};
+}
+
+// Eq. 1 (homogeneous form): the area of the ellipse inside the sector from s0 counterclockwise to s1, given
+// cross = s0 x s1 (passed in so that callers decide on its computation and clamping).
+template <class T, bool kBiased = false>
+T ellipse_sector_area(const EdgeEllipse<T>& e, const Vec2<T>& s0, const Vec2<T>& s1, T cross) {
+  const T a = std::abs(e.nz);
+  return a / T(2) * polygon_atan2<T, kBiased>(a * cross, e.form(s0, s1));
+}
+
+// ---- Sectors ------------------------------------------------------------------------------------------------
+
+template <class T> struct ProjectedSector {
+  Vec2<T> s0 = Vec2<T>::Zero(), s1 = Vec2<T>::Zero();  // boundaries, counterclockwise, at most 180 degrees
+  EdgeEllipse<T> outer, inner;                          // inner only in the decentral case
+  bool decentral = false;
+  T area = 0;
+};
+
+// The homogeneous quadratic w^T T w = 0 solved for the root of Eq. 6 (Blinn 2006 as specialised by Peters):
+// both branches give the projective root x / y = (-b - sqrt(Delta)) / a with a = T_xx, 2b = T_xy + T_yx,
+// c = T_yy, Delta = b^2 - a c (= -|T + T^T| / 4). Delta by Kahan's determinant: it cancels near double roots.
+template <class T> Vec2<T> solve_homogeneous_quadratic(const Eigen::Matrix<T, 2, 2>& Tm) {
+  const T b = (Tm(0, 1) + Tm(1, 0)) / T(2);
+  const T delta = std::max(T(0), kahan_det(b, Tm(0, 0), Tm(1, 1), b));
+  const T root = std::abs(b) + std::sqrt(delta);
+  return b >= T(0) ? Vec2<T>(root, -Tm(0, 0)) : Vec2<T>(Tm(1, 1), root);
+}
+
+// Approximate L1 normalisation (Sec. 3.7): guards against under- and overflow; the length is irrelevant.
+template <class T> Vec2<T> l1_normalized(const Vec2<T>& w) {
+  const T s = std::abs(w.x()) + std::abs(w.y());
+  return s > T(0) && std::isfinite(s) ? Vec2<T>(w / s) : w;
+}
+
+// The area between the ellipses in the sector from s0 to w (the subtracted terms of Eq. 7).
+template <class T, bool kBiased = false> T decentral_area_to(const ProjectedSector<T>& s, const Vec2<T>& w) {
+  const T cross = kahan_cross2(s.s0, w);
+  return ellipse_sector_area<T, kBiased>(s.outer, s.s0, w, cross) -
+         ellipse_sector_area<T, kBiased>(s.inner, s.s0, w, cross);
+}
+
+// Eq. 7: residual A_delta(w) = A - area(s0 -> w).
+template <class T, bool kBiased = false> T decentral_residual(const ProjectedSector<T>& s, T target, const Vec2<T>& w) {
+  return target - decentral_area_to<T, kBiased>(s, w);
+}
+
+// Section 3.4: the two-quad initialisation. The quad vertices are lambda_{l,j} s_j (l in {i, o}, j in {k, h});
+// an edge of quad k through lambda_{l,h} s_h and lambda_{l,k} s_k has the normal r_l = C_l (lambda_{l,h} s_h +
+// lambda_{l,k} s_k) (a chord of the ellipse, normal C (p + q) since p^T C p = q^T C q = 1) and the offset
+// D_l = lambda_{l,h} r_l^T s_h. Derivation of Q (Supplement A.4 is not available to us): the ray through w
+// meets edge l at D_l w / (r_l^T w), so the area of quad k in the sector from s_k to w is
+//   lambda_{o,k} D_o (s_k x w) / (2 r_o^T w) - lambda_{i,k} D_i (s_k x w) / (2 r_i^T w) = A_q;
+// with s_k x w = w^T R s_k and multiplying out, w^T Q w = 0 for the paper's
+//   Q = lambda_{o,k} D_o R s_k r_i^T - (lambda_{i,k} D_i R s_k + 2 A_q r_i) r_o^T.
+// Q is bilinear in (r_i, r_o), so we may scale r_l by any positive factor; we drop 1 / n_{l,z} so that r_l
+// stays finite as n_{i,z} -> 0. For quad k = 1 the area is measured from s_1, i.e. it is negative.
+template <class T, bool kBiased = false>
+Vec2<T> decentral_initialization(const ProjectedSector<T>& s, T target) {
+  const Vec2<T> s0 = s.s0 / s.s0.norm(), s1 = s.s1 / s.s1.norm();
+  const Vec2<T> sh = s0 + s1;  // Eq. 8
+  auto lambda = [](const EdgeEllipse<T>& e, const Vec2<T>& v) {
+    const T f = e.form(v, v);
+    return f > T(0) ? std::abs(e.nz) / std::sqrt(f) : T(0);
+  };
+  const T li0 = lambda(s.inner, s0), lih = lambda(s.inner, sh), li1 = lambda(s.inner, s1);
+  const T lo0 = lambda(s.outer, s0), loh = lambda(s.outer, sh), lo1 = lambda(s.outer, s1);
+  // Quad areas by the shoelace formula of the diagonals.
+  auto quad_area = [](const Vec2<T>& a, const Vec2<T>& b, const Vec2<T>& c, const Vec2<T>& d) {
+    return std::abs(kahan_cross2<T>(c - a, d - b)) / T(2);
+  };
+  const T q0 = quad_area(li0 * s0, lih * sh, loh * sh, lo0 * s0);
+  const T q1 = quad_area(li1 * s1, lih * sh, loh * sh, lo1 * s1);
+  const T scaled = s.area > T(0) ? target * (q0 + q1) / s.area : T(0);
+  const bool first = scaled <= q0;
+  const Vec2<T>& sk = first ? s0 : s1;
+  const T lik = first ? li0 : li1, lok = first ? lo0 : lo1;
+  const T aq = first ? scaled : scaled - (q0 + q1);
+  // r_l scaled by 1 / |n_{l,z}|: C_l lambda = Ct_l / n_z^2 * |n_z| mu = Ct_l mu / |n_z|, mu = 1 / sqrt(v^T Ct v).
+  auto mu = [](const EdgeEllipse<T>& e, const Vec2<T>& v) {
+    const T f = e.form(v, v);
+    return f > T(0) ? T(1) / std::sqrt(f) : T(0);
+  };
+  const Vec2<T> ri = s.inner.times(Vec2<T>(mu(s.inner, sh) * sh + mu(s.inner, sk) * sk));
+  const Vec2<T> ro = s.outer.times(Vec2<T>(mu(s.outer, sh) * sh + mu(s.outer, sk) * sk));
+  const T di = lih * ri.dot(sh), do_ = loh * ro.dot(sh);
+  const Vec2<T> rsk(-sk.y(), sk.x());  // R s_k
+  const Eigen::Matrix<T, 2, 2> Q =
+      (lok * do_) * rsk * ri.transpose() - (Vec2<T>(lik * di * rsk + T(2) * aq * ri)) * ro.transpose();
+  Vec2<T> w = solve_homogeneous_quadratic<T>(Q);
+  if (w.dot(sh) < T(0)) w = -w;
+  if (!(std::abs(w.x()) + std::abs(w.y()) > T(0)) || !all_finite(Vec3<T>(w.x(), w.y(), T(0)))) w = sh;
+  return l1_normalized(w);
+}
+
+// Section 3.3: one step of the tangent-line iteration (Eq. 5 in homogeneous form, Eq. 6, Eq. 7).
+template <class T, bool kBiased = false>
+Vec2<T> decentral_iteration(const ProjectedSector<T>& s, T target, const Vec2<T>& wn) {
+  const T a_delta = decentral_residual<T, kBiased>(s, target, wn);
+  const Vec2<T> ci_w = s.inner.times(wn), co_w = s.outer.times(wn);
+  const Vec2<T> rw(-wn.y(), wn.x());  // R w_n
+  const Eigen::Matrix<T, 2, 2> Tm =
+      rw * Vec2<T>(s.outer.c() * ci_w - s.inner.c() * co_w).transpose() - (T(2) * a_delta) * ci_w * co_w.transpose();
+  Vec2<T> w = solve_homogeneous_quadratic<T>(Tm);
+  // "The sign on the resulting direction may be wrong, so we check the dot product with the half-vector."
+  const Vec2<T> sh = s.s0 / s.s0.norm() + s.s1 / s.s1.norm();
+  if (w.dot(sh) < T(0)) w = -w;
+  // All coefficients vanish where the ellipses meet at the horizon (Sec. 3.5): keep the current direction.
+  if (!(std::abs(w.x()) + std::abs(w.y()) > T(0)) || !std::isfinite(w.x()) || !std::isfinite(w.y())) return wn;
+  return l1_normalized(w);
+}
+
+// The decentral inversion: initialisation plus `iterations` steps.
+template <class T, bool kBiased = false>
+Vec2<T> invert_decentral_sector(const ProjectedSector<T>& s, T target, int iterations) {
+  Vec2<T> w = decentral_initialization<T, kBiased>(s, target);
+  for (int k = 0; k < iterations; ++k) w = decentral_iteration<T, kBiased>(s, target, w);
+  return w;
+}
+
+// Section 3.2: the central case in closed form. The angle in the Cholesky-transformed circle is
+// phi = 2 sqrt|C| A = 2 A / |n_z|; the 2x2 system (-s0^T R w, s0^T C w / sqrt|C|) ~ (sin phi, cos phi),
+// with its second row multiplied by |n_z|^2 (homogeneous form), is solved by Cramer's rule. Its determinant
+// is -s0^T Ct s0 < 0; w is only needed up to a positive factor, so we multiply by -det instead of dividing.
+template <class T> Vec2<T> invert_central_sector(const ProjectedSector<T>& s, T target) {
+  const T a = std::abs(s.outer.nz);
+  const T phi = a > T(0) ? std::min(T(2) * target / a, kPi<T>) : T(0);
+  const T b1 = std::sin(phi), b2 = a * std::cos(phi);
+  const Vec2<T> r1(-s.s0.y(), s.s0.x());
+  const Vec2<T> r2 = s.outer.times(s.s0);
+  return l1_normalized(Vec2<T>(r1.y() * b2 - r2.y() * b1, r2.x() * b1 - r1.x() * b2));
+}
+
+// ---- The per-light precomputation ----------------------------------------------------------------------------
+
+template <class T> struct PolygonProjectedView {
+  NoSample reason = NoSample::kNone;
+  Frame<T> frame = Frame<T>::from_z(Vec3<T>(T(0), T(0), T(1)));
+  bool flip_y = false;           // y flipped so that the vertex order winds positively (Sec. 3.1)
+  LocalPolygon<T> clipped;       // in the (flipped) shading frame, clipped to z >= 0
+  std::array<Vec3<T>, kMaxClippedVertices> edge_normals{};  // n_j = v_j x v_{j+1} (Kahan), not normalised
+  bool central = true;
+  int sector_count = 0;
+  std::array<ProjectedSector<T>, kMaxClippedVertices> sectors{};
+  T projected_solid_angle = 0;   // A_Sigma, the sum of the sector areas
+
+  bool valid() const { return reason == NoSample::kNone; }
+  Vec3<T> to_local(const Vec3<T>& w) const {
+    Vec3<T> l = frame.to_local(w);
+    if (flip_y) l.y() = -l.y();
+    return l;
+  }
+  Vec3<T> to_world(Vec3<T> l) const {
+    if (flip_y) l.y() = -l.y();
+    return frame.to_world(l);
+  }
+};
+
+template <class T, bool kBiased = false> PolygonProjectedView<T> make_polygon_projected_view(const PolygonLightGeometry<T>& g) {
+  PolygonProjectedView<T> v;
+  const PolygonView<T> pv = make_polygon_view(g);
+  if (!pv.valid()) return v.reason = pv.reason, v;
+  v.frame = pv.frame;
+  v.flip_y = pv.plane_distance < T(0);
+  LocalPolygon<T> local = pv.local;
+  if (v.flip_y)
+    for (int i = 0; i < local.count; ++i) local.v[i].y() = -local.v[i].y();
+  v.clipped = clip_to_upper_hemisphere(local);
+  const int m = v.clipped.count;
+  bool above = false;
+  for (int i = 0; i < m; ++i) above = above || v.clipped.v[i].z() > T(0);
+  if (m < 3 || !above) return v.reason = NoSample::kBelowHorizon, v;
+
+  std::array<int, kMaxClippedVertices> sign{};
+  std::array<EdgeEllipse<T>, kMaxClippedVertices> ell{};
+  bool any_negative = false, any_positive = false;
+  for (int j = 0; j < m; ++j) {
+    v.edge_normals[j] = kahan_cross(v.clipped.v[j], v.clipped.v[(j + 1) % m]);
+    const T nz = v.edge_normals[j].z();  // = kahan_cross2 of the xy parts: the sorting comparison
+    sign[j] = nz > T(0) ? 1 : (nz < T(0) ? -1 : 0);
+    any_negative = any_negative || sign[j] < 0;
+    any_positive = any_positive || sign[j] > 0;
+    ell[j] = edge_ellipse(safe_normalized(v.edge_normals[j]));
+  }
+  if (!any_positive) return v.reason = NoSample::kTooSmall, v;  // no projected area representable
+  auto xy = [&](int i) { return Vec2<T>(v.clipped.v[(i % m + m) % m].x(), v.clipped.v[(i % m + m) % m].y()); };
+  v.central = !any_negative;
+  if (v.central) {
+    // Sec. 3.1, Fig. 3a: one sector per edge. Its sine s0 x s1 is n_{j,z} >= 0 by construction.
+    for (int j = 0; j < m; ++j) {
+      ProjectedSector<T>& s = v.sectors[v.sector_count++];
+      s.s0 = xy(j), s.s1 = xy(j + 1), s.outer = ell[j];
+      s.area = std::max(T(0), ellipse_sector_area<T, kBiased>(s.outer, s.s0, s.s1, v.edge_normals[j].z()));
+    }
+  } else {
+    // Fig. 3b: find the clockwise end c (first edge of the outer chain), then merge the chains.
+    int c = -1;
+    for (int j = 0; j < m && c < 0; ++j)
+      if (sign[j] > 0 && sign[(j + m - 1) % m] <= 0) c = j;
+    if (c < 0) return v.reason = NoSample::kTooSmall, v;
+    std::array<int, kMaxClippedVertices + 1> ov{}, oe{}, iv{}, ie{};
+    int no = 0, ni = 0;
+    ov[0] = c;
+    for (int j = c, k = 0; sign[j % m] > 0 && k < m; ++j, ++k) oe[no] = j % m, ov[++no] = (j + 1) % m;
+    int b = c;
+    for (int k = 0; sign[(b + m - 1) % m] == 0 && k < m; ++k) b = (b + m - 1) % m;  // a radial edge at the end
+    iv[0] = b;
+    for (int j = (b + m - 1) % m, k = 0; sign[j] < 0 && k < m; j = (j + m - 1) % m, ++k) ie[ni] = j, iv[++ni] = j;
+    int a = 0, bi = 0;
+    Vec2<T> cur = xy(ov[0]);
+    while (a < no && bi < ni && v.sector_count < kMaxClippedVertices) {
+      const Vec2<T> next_o = xy(ov[a + 1]), next_i = xy(iv[bi + 1]);
+      const T order = kahan_cross2(next_o, next_i);
+      ProjectedSector<T>& s = v.sectors[v.sector_count++];
+      s.decentral = true;
+      s.outer = ell[oe[a]], s.inner = ell[ie[bi]];
+      s.s0 = cur;
+      if (order > T(0)) s.s1 = next_o, ++a;
+      else if (order < T(0)) s.s1 = next_i, ++bi;
+      else s.s1 = next_o, ++a, ++bi;
+      cur = s.s1;
+      const T cross = kahan_cross2(s.s0, s.s1);
+      const T sine = cross > T(0) ? cross : T(0);  // a sector is at most 180 degrees: clamp rounding
+      s.area = std::max(T(0), ellipse_sector_area<T, kBiased>(s.outer, s.s0, s.s1, sine) -
+                                  ellipse_sector_area<T, kBiased>(s.inner, s.s0, s.s1, sine));
+    }
+  }
+  T total = 0;
+  for (int k = 0; k < v.sector_count; ++k) total += v.sectors[k].area;
+  if (!(total > T(0)) || !std::isfinite(total)) return v.reason = NoSample::kTooSmall, v;
+  v.projected_solid_angle = total;
+  return v;
+}
+
+// ---- Sampling and density ------------------------------------------------------------------------------------
+
+template <class T> T pdf_polygon_projected_solid_angle(const PolygonProjectedView<T>& v, const Vec3<T>& w) {
+  if (!v.valid() || !all_finite(w)) return T(0);
+  const Vec3<T> l = v.to_local(w);
+  if (!(l.z() > T(0))) return T(0);
+  for (int j = 0; j < v.clipped.count; ++j)
+    if (v.edge_normals[j].dot(l) < T(0)) return T(0);
+  const T len = w.norm();
+  return len > T(0) ? l.z() / len / v.projected_solid_angle : T(0);
+}
+
+// `iterations`: tangent-line iterations in the decentral case (the paper's default, 2).
+template <class T, bool kBiased = false>
+DirectionSample<T> sample_polygon_projected_solid_angle(const PolygonProjectedView<T>& v, const Vec2<T>& u,
+                                                        int iterations = 2) {
+  if (!v.valid()) return DirectionSample<T>::none(v.reason);
+  // Sector selection by xi_0 (Sec. 3.2): A = xi_0 A_Sigma - sum_{k<j} A_k in [0, A_j).
+  T target = u[0] * v.projected_solid_angle;
+  int k = -1;
+  for (int i = 0; i < v.sector_count; ++i) {
+    if (!(v.sectors[i].area > T(0))) continue;
+    k = i;
+    if (target < v.sectors[i].area) break;
+    target -= v.sectors[i].area;
+  }
+  if (k < 0) return DirectionSample<T>::none(NoSample::kTooSmall);
+  const ProjectedSector<T>& s = v.sectors[k];
+  target = std::clamp(target, T(0), s.area);
+  Vec2<T> w;
+  T rho2;  // rho^2 with w of unit "length" in the sense of the 1 / (w^T C w) factors
+  if (!s.decentral) {
+    w = invert_central_sector(s, target);
+    rho2 = u[1] * s.outer.inverse_quadratic(w);  // Sec. 3.2: rho^2 = xi_1 / (w^T C w)
+  } else {
+    w = invert_decentral_sector<T, kBiased>(s, target, iterations);
+    // Sec. 3.3: rho^2 = (1 - xi_1) / (w^T C_i w) + xi_1 / (w^T C_o w)
+    rho2 = (T(1) - u[1]) * s.inner.inverse_quadratic(w) + u[1] * s.outer.inverse_quadratic(w);
+  }
+  // Eq. 2: project up to the hemisphere.
+  const T r2 = std::min(T(1), rho2 * w.squaredNorm());
+  const T rho = std::sqrt(rho2);
+  const Vec3<T> local(rho * w.x(), rho * w.y(), std::sqrt(std::max(T(0), T(1) - r2)));
+  DirectionSample<T> out;
+  out.direction = safe_normalized(v.to_world(local));
+  if (out.direction.isZero()) return DirectionSample<T>::none(NoSample::kTooSmall);
+  out.pdf = v.to_local(out.direction).z() / v.projected_solid_angle;
+  if (!(out.pdf > T(0)) || !std::isfinite(out.pdf)) return DirectionSample<T>::none(NoSample::kOnSilhouette);
+  return out;
+}
+
+template <class T>
+DirectionSample<T> sample_polygon_projected_solid_angle(const PolygonLightGeometry<T>& g, const Vec2<T>& u,
+                                                        int iterations = 2) {
+  return sample_polygon_projected_solid_angle<T, false>(make_polygon_projected_view<T, false>(g), u, iterations);
+}
+template <class T> T pdf_polygon_projected_solid_angle(const PolygonLightGeometry<T>& g, const Vec3<T>& w) {
+  return pdf_polygon_projected_solid_angle(make_polygon_projected_view<T, false>(g), w);
+}
+
+// Section 6.4, the biased variant: no iteration and the approximate atan2 everywhere the areas need one.
+// Its pdf is the one a renderer would use, cos / A_Sigma with the approximate A_Sigma; the true density of
+// its samples differs from it by the initialisation's error (that is the bias).
+template <class T> DirectionSample<T> sample_polygon_projected_solid_angle_biased(const PolygonLightGeometry<T>& g,
+                                                                                 const Vec2<T>& u) {
+  return sample_polygon_projected_solid_angle<T, true>(make_polygon_projected_view<T, true>(g), u, 0);
+}
+template <class T> T pdf_polygon_projected_solid_angle_biased(const PolygonLightGeometry<T>& g, const Vec3<T>& w) {
+  return pdf_polygon_projected_solid_angle(make_polygon_projected_view<T, true>(g), w);
+}
+
+}  // namespace warpcheck

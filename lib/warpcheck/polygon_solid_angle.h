@@ -1,0 +1,302 @@
+// warpcheck/polygon_solid_angle.h: solid-angle sampling of convex polygons, Peters 2021 Section 5 (plain and
+// clipped to the upper hemisphere), and the published baselines for polygons: Arvo 1995 (stratified
+// sampling of spherical triangles, applied to a triangle fan) and Turk 1992 (uniform area sampling, density
+// reported per solid angle).
+//
+// Densities:  solid angle  pdf(w) = 1 / Omega inside the polygon's cone (clipped or not);
+//             Arvo 1995    the same, with Omega = sum of the fan triangles' alpha + beta + gamma - pi;
+//             Turk 1992    pdf(w) = h^2 / (|N.w|^3 Area) where the ray meets the polygon (h: distance of the
+//                          shading point from the light's plane, N: unit normal of the plane).
+// The unclipped kernels sample the whole polygon, also where it lies below the shading horizon (those
+// samples carry a zero cosine for the caller); only a light entirely below it gives "no sample".
+#pragma once
+
+#include "warpcheck/polygon.h"
+
+namespace warpcheck {
+
+// The polygon as seen from the shading point, in world space, wound positively (det(p0, p1, p2) > 0).
+template <class T> struct PolygonFanView {
+  NoSample reason = NoSample::kNone;
+  int count = 0;
+  std::array<Vec3<T>, kMaxClippedVertices> p{};       // vertex - shading point
+  std::array<Vec3<T>, kMaxClippedVertices> e{};       // p_k - p_0, from the light's own vertices if unclipped
+  std::array<Vec3<T>, kMaxClippedVertices> u{};       // p_k / |p_k|
+  std::array<Vec3<T>, kMaxClippedVertices> inward{};  // p_j x p_{j+1}: the cone is {w : inward_j . w >= 0}
+  Vec3<T> plane_normal = Vec3<T>::Zero();             // unit
+  T plane_distance = 0;                               // |plane_normal . p_0| > 0
+  bool valid() const { return reason == NoSample::kNone; }
+};
+
+// u_b - u_a for u = p / |p|, from the edge e = p_b - p_a without cancellation:
+// u_b - u_a = (e |p_a| - p_a (|p_b| - |p_a|)) / (|p_a| |p_b|), |p_b| - |p_a| = e.(p_a + p_b) / (|p_a| + |p_b|).
+template <class T> Vec3<T> unit_difference(const Vec3<T>& pa, const Vec3<T>& pb, const Vec3<T>& e) {
+  const T na = pa.norm(), nb = pb.norm();
+  const T dn = e.dot(Vec3<T>(pa + pb)) / (na + nb);
+  return (e * na - pa * dn) / (na * nb);
+}
+
+template <class T> PolygonFanView<T> make_polygon_fan_view(const PolygonLightGeometry<T>& g, bool clipped) {
+  PolygonFanView<T> f;
+  const PolygonView<T> pv = make_polygon_view(g);
+  if (!pv.valid()) return f.reason = pv.reason, f;
+  f.plane_normal = pv.plane_normal;
+  f.plane_distance = std::abs(pv.plane_distance);
+  bool above = false;
+  for (int i = 0; i < pv.local.count; ++i) above = above || pv.local.v[i].z() > T(0);
+  if (!above) return f.reason = NoSample::kBelowHorizon, f;
+  const bool reverse = pv.plane_distance < T(0);
+  if (!clipped) {
+    const int m = g.light.count;
+    f.count = m;
+    for (int k = 0; k < m; ++k) {
+      const int src = reverse ? (m - k) % m : k;  // keeps vertex 0 first
+      f.p[k] = g.light.vertices[src] - g.shading.position;
+      f.e[k] = g.light.vertices[src] - g.light.vertices[0];
+    }
+  } else {
+    const LocalPolygon<T> c = clip_to_upper_hemisphere(pv.local);
+    bool strictly_above = false;
+    for (int i = 0; i < c.count; ++i) strictly_above = strictly_above || c.v[i].z() > T(0);
+    if (c.count < 3 || !strictly_above) return f.reason = NoSample::kBelowHorizon, f;
+    f.count = c.count;
+    for (int k = 0; k < c.count; ++k) f.p[k] = pv.frame.to_world(c.v[reverse ? (c.count - k) % c.count : k]);
+    for (int k = 0; k < c.count; ++k) f.e[k] = f.p[k] - f.p[0];
+  }
+  for (int k = 0; k < f.count; ++k) {
+    f.u[k] = safe_normalized(f.p[k]);
+    if (f.u[k].isZero()) return f.reason = NoSample::kNonFinite, f;
+  }
+  for (int j = 0; j < f.count; ++j) f.inward[j] = kahan_cross(f.p[j], f.p[(j + 1) % f.count]);
+  return f;
+}
+
+template <class T> bool in_fan_cone(const PolygonFanView<T>& f, const Vec3<T>& w) {
+  for (int j = 0; j < f.count; ++j)
+    if (f.inward[j].dot(w) < T(0)) return false;
+  return true;
+}
+
+// ---- Peters 2021 Section 5 -------------------------------------------------------------------------------
+
+template <class T> struct PolygonSolidAngleView {
+  PolygonFanView<T> fan;
+  std::array<T, kMaxClippedVertices> g0{}, area{};  // per fan triangle (0, k, k+1), stored at index k
+  T solid_angle = 0;
+  NoSample reason = NoSample::kNone;
+  bool valid() const { return reason == NoSample::kNone; }
+};
+
+// Eq. 13 (van Oosterom & Strackee) per fan triangle. G0 = det(v0, v1, v2) is computed as
+// p0 . (e1 x e2) / (|p0| |p1| |p2|) from the light's edges: a determinant of three nearly parallel unit vectors
+// cancels catastrophically for small, distant lights. (Peters uses a Householder reflection, Supplement C,
+// which is not available to us; this is our own remedy.)
+template <class T> PolygonSolidAngleView<T> make_polygon_solid_angle_view(const PolygonLightGeometry<T>& g,
+                                                                          bool clipped = false) {
+  PolygonSolidAngleView<T> v;
+  v.fan = make_polygon_fan_view(g, clipped);
+  if (!v.fan.valid()) return v.reason = v.fan.reason, v;
+  const auto& f = v.fan;
+  for (int k = 1; k + 1 < f.count; ++k) {
+    const T det = f.p[0].dot(kahan_cross(f.e[k], f.e[k + 1]));
+    v.g0[k] = det / (f.p[0].norm() * f.p[k].norm() * f.p[k + 1].norm());
+    const T denom = T(1) + f.u[0].dot(f.u[k]) + f.u[0].dot(f.u[k + 1]) + f.u[k].dot(f.u[k + 1]);
+    v.area[k] = std::max(T(0), T(2) * std::atan2(v.g0[k], denom));
+    v.solid_angle += v.area[k];
+  }
+  if (!(v.solid_angle > T(0)) || !std::isfinite(v.solid_angle)) v.reason = NoSample::kTooSmall;
+  return v;
+}
+
+// Picks the fan triangle for xi_0 in proportion to `area`, returning the remaining area in it.
+template <class T> int pick_fan_triangle(const std::array<T, kMaxClippedVertices>& area, int count, T target,
+                                         T* remaining) {
+  int k = -1;
+  for (int i = 1; i + 1 < count; ++i) {
+    if (!(area[i] > T(0))) continue;
+    k = i;
+    if (target < area[i]) break;
+    target -= area[i];
+  }
+  if (k > 0) *remaining = std::clamp(target, T(0), area[k]);
+  return k;
+}
+
+// Arvo's second step (shared by Section 5 and Arvo 1995): a direction on the arc from b towards c with
+// 1 - cos(angle from b) = xi (1 - b.c), given d = c - b (accurately). With h = |d|^2 / 2 = 1 - b.c, the
+// component of c orthogonal to b is d + h b: no cancellation for short arcs.
+template <class T> Vec3<T> sample_arc(const Vec3<T>& b, const Vec3<T>& d, T xi) {
+  const T h = d.squaredNorm() / T(2);
+  const T one_minus_z = xi * h;
+  const T sin_theta = std::sqrt(std::max(T(0), one_minus_z * (T(2) - one_minus_z)));
+  const Vec3<T> t = safe_normalized(Vec3<T>(d + h * b));
+  return safe_normalized(Vec3<T>(b - one_minus_z * b + sin_theta * t));
+}
+
+template <class T> T pdf_polygon_solid_angle(const PolygonSolidAngleView<T>& v, const Vec3<T>& w) {
+  if (!v.valid() || !all_finite(w) || !in_fan_cone(v.fan, w)) return T(0);
+  return T(1) / v.solid_angle;
+}
+
+// Section 5: the new vertex v2' on the edge v0 v2 with triangle (v0, v1, v2') of solid angle A:
+//   r = (G0 cos(A/2) - G1 sin(A/2)) v0 + G2 sin(A/2) v2,  v2' = -v0 + 2 (v0.r / |r|^2) r,
+// rewritten without cancellation as v2' = v0 + 2 r x (r x v0) / |r|^2 (the identity a x (b x c) =
+// b (a.c) - c (a.b)), where r x v0 = G2 sin(A/2) (v2 x v0) and v2 x v0 = (e2 x p0) / (|p2| |p0|).
+// Then Arvo's arc sampling from v1 to v2' with xi_1.
+template <class T> DirectionSample<T> sample_polygon_solid_angle(const PolygonSolidAngleView<T>& v, const Vec2<T>& u) {
+  if (!v.valid()) return DirectionSample<T>::none(v.reason);
+  const auto& f = v.fan;
+  T a = 0;
+  const int k = pick_fan_triangle(v.area, f.count, u[0] * v.solid_angle, &a);
+  if (k < 0) return DirectionSample<T>::none(NoSample::kTooSmall);
+  const Vec3<T>&v0 = f.u[0], &v1 = f.u[k], &v2 = f.u[k + 1];
+  const T g0 = v.g0[k], g1 = v0.dot(v2) + v1.dot(v2), g2 = T(1) + v0.dot(v1);
+  const T c = std::cos(a / 2), s = std::sin(a / 2);
+  const Vec3<T> r = (g0 * c - g1 * s) * v0 + (g2 * s) * v2;
+  const T r2 = r.squaredNorm();
+  const Vec3<T> v2_x_v0 = kahan_cross(f.e[k + 1], f.p[0]) / (f.p[k + 1].norm() * f.p[0].norm());
+  const Vec3<T> offset = r2 > T(0) ? Vec3<T>((T(2) * g2 * s / r2) * kahan_cross(r, v2_x_v0)) : Vec3<T>::Zero();
+  // d = v2' - v1 = (v0 - v1) + offset, with v0 - v1 from the edge e_k.
+  const Vec3<T> d = -unit_difference(f.p[0], f.p[k], f.e[k]) + offset;
+  DirectionSample<T> out;
+  out.direction = sample_arc(v1, d, u[1]);
+  if (out.direction.isZero()) return DirectionSample<T>::none(NoSample::kNonFinite);
+  out.pdf = T(1) / v.solid_angle;
+  return out;
+}
+
+template <class T> DirectionSample<T> sample_polygon_solid_angle(const PolygonLightGeometry<T>& g, const Vec2<T>& u,
+                                                                 bool clipped = false) {
+  return sample_polygon_solid_angle(make_polygon_solid_angle_view(g, clipped), u);
+}
+template <class T> T pdf_polygon_solid_angle(const PolygonLightGeometry<T>& g, const Vec3<T>& w, bool clipped = false) {
+  return pdf_polygon_solid_angle(make_polygon_solid_angle_view(g, clipped), w);
+}
+
+// ---- Baseline: Arvo 1995, "Stratified Sampling of Spherical Triangles", as published ---------------------
+//
+// Per triangle (A, B, C) with interior angles alpha, beta, gamma and area alpha + beta + gamma - pi:
+//   A^ = xi_1 area; s = sin(A^ - alpha); t = cos(A^ - alpha); u = t - cos alpha; v = s + sin alpha cos c;
+//   q = ((v t - u s) cos alpha - v) / ((v s + u t) sin alpha);  C^ = q A + sqrt(1 - q^2) |C - (C.A) A|^;
+//   z = 1 - xi_2 (1 - C^.B);  P = z B + sqrt(1 - z^2) |C^ - (C^.B) B|^
+// (c is the arc AB). Polygons are sampled as the fan (v0, v_k, v_{k+1}), triangles chosen by Arvo's areas.
+// The angle sum cancels for small triangles: that is the published method's weakness, kept on purpose.
+
+template <class T> struct ArvoFanView {
+  PolygonFanView<T> fan;
+  std::array<T, kMaxClippedVertices> alpha{}, area{};
+  T solid_angle = 0;
+  NoSample reason = NoSample::kNone;
+  bool valid() const { return reason == NoSample::kNone; }
+};
+
+template <class T> T spherical_angle(const Vec3<T>& at, const Vec3<T>& b, const Vec3<T>& c) {
+  const Vec3<T> nb = at.cross(b), nc = at.cross(c);
+  return std::atan2(nb.cross(nc).norm(), nb.dot(nc));
+}
+
+template <class T> ArvoFanView<T> make_arvo_fan_view(const PolygonLightGeometry<T>& g) {
+  ArvoFanView<T> v;
+  v.fan = make_polygon_fan_view(g, false);
+  if (!v.fan.valid()) return v.reason = v.fan.reason, v;
+  const auto& u = v.fan.u;
+  for (int k = 1; k + 1 < v.fan.count; ++k) {
+    const T al = spherical_angle(u[0], u[k], u[k + 1]);
+    const T be = spherical_angle(u[k], u[k + 1], u[0]);
+    const T ga = spherical_angle(u[k + 1], u[0], u[k]);
+    v.alpha[k] = al;
+    v.area[k] = std::max(T(0), al + be + ga - kPi<T>);
+    v.solid_angle += v.area[k];
+  }
+  if (!(v.solid_angle > T(0)) || !std::isfinite(v.solid_angle)) v.reason = NoSample::kTooSmall;
+  return v;
+}
+
+template <class T> DirectionSample<T> sample_arvo_triangle_fan(const ArvoFanView<T>& v, const Vec2<T>& xi) {
+  if (!v.valid()) return DirectionSample<T>::none(v.reason);
+  T ahat = 0;
+  const int k = pick_fan_triangle(v.area, v.fan.count, xi[0] * v.solid_angle, &ahat);
+  if (k < 0) return DirectionSample<T>::none(NoSample::kTooSmall);
+  const Vec3<T>&A = v.fan.u[0], &B = v.fan.u[k], &C = v.fan.u[k + 1];
+  const T alpha = v.alpha[k];
+  const T s = std::sin(ahat - alpha), t = std::cos(ahat - alpha);
+  const T uu = t - std::cos(alpha), vv = s + std::sin(alpha) * A.dot(B);
+  const T q = std::clamp(((vv * t - uu * s) * std::cos(alpha) - vv) / ((vv * s + uu * t) * std::sin(alpha)), T(-1), T(1));
+  const Vec3<T> chat = q * A + std::sqrt(T(1) - q * q) * safe_normalized(Vec3<T>(C - C.dot(A) * A));
+  const T z = T(1) - xi[1] * (T(1) - chat.dot(B));
+  const Vec3<T> p = z * B + std::sqrt(std::max(T(0), T(1) - z * z)) * safe_normalized(Vec3<T>(chat - chat.dot(B) * B));
+  DirectionSample<T> out;
+  out.direction = safe_normalized(p);
+  if (out.direction.isZero() || !all_finite(p)) return DirectionSample<T>::none(NoSample::kNonFinite);
+  out.pdf = T(1) / v.solid_angle;
+  return out;
+}
+
+template <class T> DirectionSample<T> sample_arvo_triangle_fan(const PolygonLightGeometry<T>& g, const Vec2<T>& xi) {
+  return sample_arvo_triangle_fan(make_arvo_fan_view(g), xi);
+}
+template <class T> T pdf_arvo_triangle_fan(const PolygonLightGeometry<T>& g, const Vec3<T>& w) {
+  const ArvoFanView<T> v = make_arvo_fan_view(g);
+  if (!v.valid() || !all_finite(w) || !in_fan_cone(v.fan, w)) return T(0);
+  return T(1) / v.solid_angle;
+}
+
+// ---- Baseline: Turk 1992, "Generating Random Points in Triangles", as published ---------------------------
+//
+// A fan triangle is chosen in proportion to its area, then P = (1 - sqrt(xi_0)) A + sqrt(xi_0) (1 - xi_1) B
+// + sqrt(xi_0) xi_1 C (xi_0 rescaled within the chosen triangle).
+
+template <class T> struct TurkAreaView {
+  PolygonFanView<T> fan;
+  std::array<T, kMaxClippedVertices> area{};
+  T total_area = 0;
+  NoSample reason = NoSample::kNone;
+  bool valid() const { return reason == NoSample::kNone; }
+};
+
+template <class T> TurkAreaView<T> make_turk_area_view(const PolygonLightGeometry<T>& g) {
+  TurkAreaView<T> v;
+  v.fan = make_polygon_fan_view(g, false);
+  if (!v.fan.valid()) return v.reason = v.fan.reason, v;
+  for (int k = 1; k + 1 < v.fan.count; ++k) {
+    v.area[k] = kahan_cross(v.fan.e[k], v.fan.e[k + 1]).norm() / T(2);
+    v.total_area += v.area[k];
+  }
+  if (!(v.total_area > T(0)) || !std::isfinite(v.total_area)) v.reason = NoSample::kZeroSize;
+  return v;
+}
+
+// Per solid angle: dA = dist^2 / cos_light dw, dist = h / |N.w|, cos_light = |N.w|.
+template <class T> T turk_density(const TurkAreaView<T>& v, const Vec3<T>& w) {
+  const T c = std::abs(v.fan.plane_normal.dot(w));
+  const T h = v.fan.plane_distance;
+  const T hc = h / c;
+  const T pdf = hc * hc / (c * v.total_area);
+  return std::isfinite(pdf) ? pdf : T(0);
+}
+
+template <class T> DirectionSample<T> sample_turk_area(const TurkAreaView<T>& v, const Vec2<T>& xi) {
+  if (!v.valid()) return DirectionSample<T>::none(v.reason);
+  T rest = 0;
+  const int k = pick_fan_triangle(v.area, v.fan.count, xi[0] * v.total_area, &rest);
+  if (k < 0) return DirectionSample<T>::none(NoSample::kTooSmall);
+  const T r = std::sqrt(v.area[k] > T(0) ? rest / v.area[k] : T(0));
+  const Vec3<T> p = v.fan.p[0] + (r * (T(1) - xi[1])) * v.fan.e[k] + (r * xi[1]) * v.fan.e[k + 1];
+  DirectionSample<T> out;
+  out.direction = safe_normalized(p);
+  if (out.direction.isZero()) return DirectionSample<T>::none(NoSample::kNonFinite);
+  out.pdf = turk_density(v, out.direction);
+  if (!(out.pdf > T(0))) return DirectionSample<T>::none(NoSample::kOnSilhouette);
+  return out;
+}
+
+template <class T> DirectionSample<T> sample_turk_area(const PolygonLightGeometry<T>& g, const Vec2<T>& xi) {
+  return sample_turk_area(make_turk_area_view(g), xi);
+}
+template <class T> T pdf_turk_area(const PolygonLightGeometry<T>& g, const Vec3<T>& w) {
+  const TurkAreaView<T> v = make_turk_area_view(g);
+  if (!v.valid() || !all_finite(w) || !in_fan_cone(v.fan, w)) return T(0);
+  return turk_density(v, Vec3<T>(w.normalized()));
+}
+
+}  // namespace warpcheck

@@ -1,0 +1,106 @@
+// warpcheck/spherical_rectangle.h: the baseline of Urena, Fajardo & King 2013, "An Area-Preserving
+// Parametrization for Spherical Rectangles", as published (their Sec. 3-4, written from the formulas).
+//
+// Rectangle with corner s and orthogonal edges e_x, e_y (from a 4-vertex PolygonLight: s = V0,
+// e_x = V1 - V0, e_y = V3 - V0). In the rectangle's frame (x, y along the edges, z = x cross y flipped so that
+// the rectangle lies at z0 < 0):
+//   corners v00, v01, v10, v11; inner normals n_i of the four planes through the origin and the edges;
+//   gamma_i = acos(-n_i.n_{i+1}); S = gamma_0 + gamma_1 + gamma_2 + gamma_3 - 2 pi (the solid angle);
+//   sampling: au = xi_0 S + k, k = 2 pi - gamma_2 - gamma_3; fu = (cos(au) b0 - b1) / sin(au);
+//   cu = sign(fu) / sqrt(fu^2 + b0^2); xu = -cu z0 / sqrt(1 - cu^2) clamped to [x0, x1];
+//   d = sqrt(xu^2 + z0^2); h0 = y0 / sqrt(d^2 + y0^2); h1 = y1 / sqrt(d^2 + y1^2);
+//   hv = h0 + xi_1 (h1 - h0); yv = hv d / sqrt(1 - hv^2) (or y1 when hv^2 >= 1 - eps).
+// pdf = 1 / S inside the rectangle's cone. Like Arvo 1995, S cancels for small rectangles (kept on purpose).
+// The only addition: a non-finite result becomes "no sample" (house rule: never NaN).
+#pragma once
+
+#include "warpcheck/polygon.h"
+
+namespace warpcheck {
+
+template <class T> struct SphericalRectangleView {
+  NoSample reason = NoSample::kNone;
+  Vec3<T> o = Vec3<T>::Zero(), x = Vec3<T>::Zero(), y = Vec3<T>::Zero(), z = Vec3<T>::Zero();  // shading point, frame
+  T x0 = 0, y0 = 0, z0 = 0, x1 = 0, y1 = 0;
+  T b0 = 0, b1 = 0, k = 0, solid_angle = 0;
+  std::array<Vec3<T>, 4> inward{};  // for the density's support test (world space)
+  bool valid() const { return reason == NoSample::kNone; }
+};
+
+template <class T> SphericalRectangleView<T> make_spherical_rectangle_view(const PolygonLightGeometry<T>& g) {
+  SphericalRectangleView<T> v;
+  const PolygonView<T> pv = make_polygon_view(g);
+  if (!pv.valid()) return v.reason = pv.reason, v;
+  if (g.light.count != 4) return v.reason = NoSample::kInvalidGeometry, v;
+  const Vec3<T> s = g.light.vertices[0];
+  const Vec3<T> ex = g.light.vertices[1] - s, ey = g.light.vertices[3] - s;
+  const T exl = ex.norm(), eyl = ey.norm();
+  // A rectangle: orthogonal edges and V2 = V0 + ex + ey (to the precision of the input).
+  const T tol = T(64) * std::sqrt(std::numeric_limits<T>::epsilon());
+  if (std::abs(ex.dot(ey)) > tol * exl * eyl ||
+      (g.light.vertices[2] - s - ex - ey).norm() > tol * (exl + eyl))
+    return v.reason = NoSample::kInvalidGeometry, v;
+  bool above = false;
+  for (int i = 0; i < 4; ++i) above = above || pv.local.v[i].z() > T(0);
+  if (!above) return v.reason = NoSample::kBelowHorizon, v;
+  v.o = g.shading.position;
+  v.x = ex / exl, v.y = ey / eyl, v.z = v.x.cross(v.y);
+  const Vec3<T> d = s - v.o;
+  v.z0 = d.dot(v.z);
+  if (v.z0 > T(0)) v.z = -v.z, v.z0 = -v.z0;
+  v.x0 = d.dot(v.x), v.y0 = d.dot(v.y);
+  v.x1 = v.x0 + exl, v.y1 = v.y0 + eyl;
+  const Vec3<T> v00(v.x0, v.y0, v.z0), v01(v.x0, v.y1, v.z0), v10(v.x1, v.y0, v.z0), v11(v.x1, v.y1, v.z0);
+  const Vec3<T> n0 = v00.cross(v10).normalized(), n1 = v10.cross(v11).normalized();
+  const Vec3<T> n2 = v11.cross(v01).normalized(), n3 = v01.cross(v00).normalized();
+  auto clamped_acos = [](T c) { return std::acos(std::clamp(c, T(-1), T(1))); };
+  const T g0 = clamped_acos(-n0.dot(n1)), g1 = clamped_acos(-n1.dot(n2));
+  const T g2 = clamped_acos(-n2.dot(n3)), g3 = clamped_acos(-n3.dot(n0));
+  v.b0 = n0.z(), v.b1 = n2.z();
+  v.k = kTwoPi<T> - g2 - g3;
+  v.solid_angle = g0 + g1 - v.k;
+  if (!(v.solid_angle > T(0)) || !std::isfinite(v.solid_angle)) return v.reason = NoSample::kTooSmall, v;
+  // Support test in world space: inward normals of the rectangle's cone.
+  std::array<Vec3<T>, 4> c;
+  for (int i = 0; i < 4; ++i) c[i] = g.light.vertices[i] - g.shading.position;
+  const T orient = pv.plane_distance > T(0) ? T(1) : T(-1);
+  for (int i = 0; i < 4; ++i) v.inward[i] = orient * kahan_cross(c[i], c[(i + 1) % 4]);
+  return v;
+}
+
+template <class T> DirectionSample<T> sample_spherical_rectangle(const SphericalRectangleView<T>& v, const Vec2<T>& xi) {
+  if (!v.valid()) return DirectionSample<T>::none(v.reason);
+  const T au = xi[0] * v.solid_angle + v.k;
+  const T fu = (std::cos(au) * v.b0 - v.b1) / std::sin(au);
+  T cu = (fu > T(0) ? T(1) : T(-1)) / std::sqrt(fu * fu + v.b0 * v.b0);
+  cu = std::clamp(cu, T(-1), T(1));
+  T xu = -(cu * v.z0) / std::sqrt(T(1) - cu * cu);
+  xu = std::clamp(xu, v.x0, v.x1);
+  const T d = std::sqrt(xu * xu + v.z0 * v.z0);
+  const T h0 = v.y0 / std::sqrt(d * d + v.y0 * v.y0), h1 = v.y1 / std::sqrt(d * d + v.y1 * v.y1);
+  const T hv = h0 + xi[1] * (h1 - h0), hv2 = hv * hv;
+  const T yv = hv2 < T(1) - std::numeric_limits<T>::epsilon() ? hv * d / std::sqrt(T(1) - hv2) : v.y1;
+  const Vec3<T> p = xu * v.x + yv * v.y + v.z0 * v.z;
+  DirectionSample<T> out;
+  if (!all_finite(p)) return DirectionSample<T>::none(NoSample::kNonFinite);
+  out.direction = safe_normalized(p);
+  if (out.direction.isZero()) return DirectionSample<T>::none(NoSample::kNonFinite);
+  out.pdf = T(1) / v.solid_angle;
+  return out;
+}
+
+template <class T> T pdf_spherical_rectangle(const SphericalRectangleView<T>& v, const Vec3<T>& w) {
+  if (!v.valid() || !all_finite(w)) return T(0);
+  for (const auto& n : v.inward)
+    if (n.dot(w) < T(0)) return T(0);
+  return T(1) / v.solid_angle;
+}
+
+template <class T> DirectionSample<T> sample_spherical_rectangle(const PolygonLightGeometry<T>& g, const Vec2<T>& xi) {
+  return sample_spherical_rectangle(make_spherical_rectangle_view(g), xi);
+}
+template <class T> T pdf_spherical_rectangle(const PolygonLightGeometry<T>& g, const Vec3<T>& w) {
+  return pdf_spherical_rectangle(make_spherical_rectangle_view(g), w);
+}
+
+}  // namespace warpcheck

@@ -1,0 +1,254 @@
+// Polygon-light kernels (Peters 2021 and the published baselines) and their named configurations.
+#include <cmath>
+#include <functional>
+
+#include "warpcheck/polygon_projected.h"
+#include "warpcheck/polygon_solid_angle.h"
+#include "warpcheck/spherical_rectangle.h"
+#include "warpcheck/validation/registry.h"
+
+namespace warpcheck::validation {
+namespace {
+
+// Bounding caps: the support's vertices (clipped where the kernel clips) as directions from the shading point.
+template <class T> Cap<T> cap_of_fan(const PolygonFanView<T>& f) { return bounding_cap_of_directions(f.p.data(), f.count); }
+template <class T> Cap<T> cap_of_projected(const PolygonProjectedView<T>& v) {
+  std::array<Vec3<T>, kMaxClippedVertices> w;
+  for (int i = 0; i < v.clipped.count; ++i) w[i] = v.to_world(v.clipped.v[i]);
+  return bounding_cap_of_directions(w.data(), v.clipped.count);
+}
+template <class T> Cap<T> cap_of_polygon(const PolygonLightGeometry<T>& g) {
+  std::array<Vec3<T>, kMaxPolygonVertices> w;
+  for (int i = 0; i < g.light.count; ++i) w[i] = g.light.vertices[i] - g.shading.position;
+  return bounding_cap_of_directions(w.data(), g.light.count);
+}
+
+template <class T> struct ProjectedKernel {
+  // The density with the per-light precomputation done once (the battery's quadrature calls it millions of times).
+  static std::function<Real(const Vec3L&)> cached_pdf(const PolygonLightGeometry<T>& g) {
+    return [v = make_polygon_projected_view<T>(g)](const Vec3L& wl) {
+      const Vec3<T> w = wl.template cast<T>();
+      return Real(pdf_polygon_projected_solid_angle(v, w));
+    };
+  }
+  using Scalar = T;
+  using Geometry = PolygonLightGeometry<T>;
+  static DirectionSample<T> sample(const Geometry& g, const Vec2<T>& u) { return sample_polygon_projected_solid_angle(g, u); }
+  static T pdf(const Geometry& g, const Vec3<T>& w) { return pdf_polygon_projected_solid_angle(g, w); }
+  static Cap<T> bounding_cap(const Geometry& g) {
+    const auto v = make_polygon_projected_view<T>(g);
+    return v.valid() ? cap_of_projected(v) : cap_of_polygon(g);
+  }
+  static T normaliser(const Geometry& g) { return make_polygon_projected_view<T>(g).projected_solid_angle; }
+};
+
+template <class T> struct BiasedKernel {
+  // The density with the per-light precomputation done once (the battery's quadrature calls it millions of times).
+  static std::function<Real(const Vec3L&)> cached_pdf(const PolygonLightGeometry<T>& g) {
+    return [v = make_polygon_projected_view<T, true>(g)](const Vec3L& wl) {
+      const Vec3<T> w = wl.template cast<T>();
+      return Real(pdf_polygon_projected_solid_angle(v, w));
+    };
+  }
+  using Scalar = T;
+  using Geometry = PolygonLightGeometry<T>;
+  static DirectionSample<T> sample(const Geometry& g, const Vec2<T>& u) { return sample_polygon_projected_solid_angle_biased(g, u); }
+  static T pdf(const Geometry& g, const Vec3<T>& w) { return pdf_polygon_projected_solid_angle_biased(g, w); }
+  static Cap<T> bounding_cap(const Geometry& g) { return ProjectedKernel<T>::bounding_cap(g); }
+  static T normaliser(const Geometry& g) { return make_polygon_projected_view<T, true>(g).projected_solid_angle; }
+};
+
+template <class T, bool kClipped> struct SolidAngleKernel {
+  // The density with the per-light precomputation done once (the battery's quadrature calls it millions of times).
+  static std::function<Real(const Vec3L&)> cached_pdf(const PolygonLightGeometry<T>& g) {
+    return [v = make_polygon_solid_angle_view(g, kClipped)](const Vec3L& wl) {
+      const Vec3<T> w = wl.template cast<T>();
+      return Real(pdf_polygon_solid_angle(v, w));
+    };
+  }
+  using Scalar = T;
+  using Geometry = PolygonLightGeometry<T>;
+  static DirectionSample<T> sample(const Geometry& g, const Vec2<T>& u) { return sample_polygon_solid_angle(g, u, kClipped); }
+  static T pdf(const Geometry& g, const Vec3<T>& w) { return pdf_polygon_solid_angle(g, w, kClipped); }
+  static Cap<T> bounding_cap(const Geometry& g) {
+    const auto f = make_polygon_fan_view(g, kClipped);
+    return f.valid() ? cap_of_fan(f) : cap_of_polygon(g);
+  }
+  static T normaliser(const Geometry& g) { return make_polygon_solid_angle_view(g, kClipped).solid_angle; }
+};
+template <class T> using SolidAngleUnclipped = SolidAngleKernel<T, false>;
+template <class T> using SolidAngleClipped = SolidAngleKernel<T, true>;
+
+template <class T> struct ArvoKernel {
+  // The density with the per-light precomputation done once (the battery's quadrature calls it millions of times).
+  static std::function<Real(const Vec3L&)> cached_pdf(const PolygonLightGeometry<T>& g) {
+    return [v = make_arvo_fan_view(g)](const Vec3L& wl) {
+      const Vec3<T> w = wl.template cast<T>();
+      return Real((v.valid() && all_finite(w) && in_fan_cone(v.fan, w) ? T(1) / v.solid_angle : T(0)));
+    };
+  }
+  using Scalar = T;
+  using Geometry = PolygonLightGeometry<T>;
+  static DirectionSample<T> sample(const Geometry& g, const Vec2<T>& u) { return sample_arvo_triangle_fan(g, u); }
+  static T pdf(const Geometry& g, const Vec3<T>& w) { return pdf_arvo_triangle_fan(g, w); }
+  static Cap<T> bounding_cap(const Geometry& g) { return SolidAngleKernel<T, false>::bounding_cap(g); }
+  static T normaliser(const Geometry& g) { return make_arvo_fan_view(g).solid_angle; }
+};
+
+template <class T> struct TurkKernel {
+  // The density with the per-light precomputation done once (the battery's quadrature calls it millions of times).
+  static std::function<Real(const Vec3L&)> cached_pdf(const PolygonLightGeometry<T>& g) {
+    return [v = make_turk_area_view(g)](const Vec3L& wl) {
+      const Vec3<T> w = wl.template cast<T>();
+      return Real((v.valid() && all_finite(w) && in_fan_cone(v.fan, w) ? turk_density(v, Vec3<T>(w.normalized())) : T(0)));
+    };
+  }
+  using Scalar = T;
+  using Geometry = PolygonLightGeometry<T>;
+  static DirectionSample<T> sample(const Geometry& g, const Vec2<T>& u) { return sample_turk_area(g, u); }
+  static T pdf(const Geometry& g, const Vec3<T>& w) { return pdf_turk_area(g, w); }
+  static Cap<T> bounding_cap(const Geometry& g) { return SolidAngleKernel<T, false>::bounding_cap(g); }
+  static T normaliser(const Geometry& g) { return make_turk_area_view(g).total_area; }
+};
+
+template <class T> struct UrenaKernel {
+  // The density with the per-light precomputation done once (the battery's quadrature calls it millions of times).
+  static std::function<Real(const Vec3L&)> cached_pdf(const PolygonLightGeometry<T>& g) {
+    return [v = make_spherical_rectangle_view(g)](const Vec3L& wl) {
+      const Vec3<T> w = wl.template cast<T>();
+      return Real(pdf_spherical_rectangle(v, w));
+    };
+  }
+  using Scalar = T;
+  using Geometry = PolygonLightGeometry<T>;
+  static DirectionSample<T> sample(const Geometry& g, const Vec2<T>& u) { return sample_spherical_rectangle(g, u); }
+  static T pdf(const Geometry& g, const Vec3<T>& w) { return pdf_spherical_rectangle(g, w); }
+  static Cap<T> bounding_cap(const Geometry& g) { return SolidAngleKernel<T, false>::bounding_cap(g); }
+  static T normaliser(const Geometry& g) { return make_spherical_rectangle_view(g).solid_angle; }
+};
+
+// What each kernel's normaliser is and its independent reference.
+enum class Measure { kProjected, kSolid, kSolidClipped, kArea, kNone };
+
+using G = PolygonLightGeometry<Real>;
+
+G geom(Vec3L x, Vec3L n, PolygonLight<Real> p) { return G{ShadingPoint<Real>{x, n}, p}; }
+
+// A square of side s centred at c in the plane spanned by unit a, b.
+PolygonLight<Real> square(Vec3L c, Vec3L a, Vec3L b, Real s) {
+  const Real h = s / 2;
+  return PolygonLight<Real>{c - h * a - h * b, c + h * a - h * b, c + h * a + h * b, c - h * a + h * b};
+}
+PolygonLight<Real> regular(int m, Vec3L c, Real r, bool reverse = false) {  // horizontal regular m-gon
+  PolygonLight<Real> p;
+  p.count = m;
+  for (int i = 0; i < m; ++i) {
+    const Real t = kTwoPi<Real> * Real(reverse ? m - i : i) / Real(m) + 0.3L;
+    p.vertices[i] = c + Vec3L(r * std::cos(t), r * std::sin(t), 0);
+  }
+  return p;
+}
+
+struct PolygonConfig {
+  const char* name;
+  const char* description;
+  G g;
+  bool rectangle;
+};
+
+const Vec3L kUp(0, 0, 1), kX(1, 0, 0), kY(0, 1, 0), kZ(0, 0, 1), kO(0, 0, 0);
+
+std::vector<PolygonConfig> configs() {
+  const Vec3L tilt = Vec3L(0.3L, -0.2L, 1).normalized();
+  return {
+      {"central-square", "1 x 1 square 1 above, normal towards it (central case)", geom(kO, kUp, square(Vec3L(0.1L, -0.1L, 1), kX, kY, 1)), true},
+      {"decentral-square", "1 x 1 square offset 1.5 sideways, 1 above, tilted normal (decentral case)",
+       geom(kO, tilt, square(Vec3L(1.5L, 0.4L, 1), kX, kY, 1)), true},
+      {"cornell", "ceiling light seen from a wall: two edges parallel to the normal (zenith case, Fig. 12)",
+       geom(kO, kX, PolygonLight<Real>{Vec3L(0.3L, 1, -0.2L), Vec3L(1.3L, 1, -0.2L), Vec3L(1.3L, 1, 0.2L), Vec3L(0.3L, 1, 0.2L)}), true},
+      {"straddling-horizon", "vertical 1 x 1.2 rectangle crossing the horizon", geom(kO, kUp, square(Vec3L(1, 0, 0.1L), kY, kZ, 1)), true},
+      {"far-1cm", "1 cm square light 40 m away (Fig. 7a)", geom(kO, kUp, square(Vec3L(20, 10, 32.4L), kX, kY, 0.01L)), true},
+      {"far-1mm", "1 mm square light 40 m away (Fig. 7b)", geom(kO, kUp, square(Vec3L(20, 10, 32.4L), kX, kY, 0.001L)), true},
+      {"nearly-edge-on", "square seen 0.3 degrees from its plane", geom(Vec3L(-2, 0.2L, 1.0105L), kX, square(Vec3L(0, 0, 1), kX, kY, 1)), true},
+      {"triangle", "triangle, reversed winding, decentral",
+       geom(kO, kUp, PolygonLight<Real>{Vec3L(0.8L, 0.9L, 0.8L), Vec3L(1.3L, -0.4L, 0.5L), Vec3L(0.3L, 0.1L, 1)}), false},
+      {"pentagon", "regular pentagon, central", geom(kO, kUp, regular(5, Vec3L(0.2L, 0.1L, 0.7L), 0.6L)), false},
+      {"hexagon-reversed", "regular hexagon, reversed winding, decentral", geom(kO, tilt, regular(6, Vec3L(1.2L, 0.3L, 0.6L), 0.5L, true)), false},
+      {"octagon", "regular octagon straddling the zenith direction of a tilted normal", geom(kO, tilt, regular(8, Vec3L(0, 0, 0.8L), 0.9L)), false},
+      {"below-horizon", "square entirely below the horizon: no sample", geom(kO, kUp, square(Vec3L(0, 0, -1), kX, kY, 1)), true},
+  };
+}
+
+template <template <class> class K, class T>
+void add_case(Registry& r, const char* kernel, const PolygonConfig& c, Measure measure) {
+  Case k;
+  k.kernel = kernel;
+  k.scalar = scalar_name<T>();
+  k.config = c.name;
+  k.description = c.description;
+  k.make = [c, kernel, measure] {
+    SamplerUnderTest s = bind_kernel<K<T>, K<Real>>(kernel, c.name, c.g.template cast<T>(), c.g);
+    s.pdf = K<T>::cached_pdf(c.g.template cast<T>());  // same density as K::pdf, without rebuilding the view
+    s.expect_no_sample = !K<Real>::sample(c.g, Vec2<Real>(0.5L, 0.5L)).valid();
+    if (s.expect_no_sample || measure == Measure::kNone) return s;
+    Normalization n;
+    n.kernel = [g = c.g.template cast<T>()] { return Real(K<T>::normaliser(g)); };
+    switch (measure) {
+      case Measure::kProjected:
+        n.what = "projected solid angle (Lambert)", n.reference = reference_projected_solid_angle(c.g);
+        break;
+      case Measure::kSolid:
+        n.what = "solid angle (van Oosterom-Strackee)", n.reference = reference_solid_angle(c.g);
+        break;
+      case Measure::kSolidClipped:
+        n.what = "clipped solid angle (van Oosterom-Strackee)", n.reference = reference_solid_angle(c.g, true);
+        break;
+      case Measure::kArea: {
+        n.what = "polygon area (shoelace in long double)";
+        Vec3L a = Vec3L::Zero();
+        for (int i = 0; i < c.g.light.count; ++i) a += c.g.light.vertices[i].cross(c.g.light.vertices[(i + 1) % c.g.light.count]);
+        n.reference = a.norm() / 2;
+        break;
+      }
+      case Measure::kNone: break;
+    }
+    s.normalizations.push_back(n);
+    if constexpr (std::is_same_v<T, float>) {
+      // Input rounding alone perturbs a light of size s at distance d by ~eps d / s relative (see
+      // test_polygon.cpp's normalisation tolerance); 64 eps (1 + d / s), stated a priori.
+      Real d = 0, size = 0;
+      for (int i = 0; i < c.g.light.count; ++i) {
+        d = std::max(d, (c.g.light.vertices[i] - c.g.shading.position).norm());
+        for (int j = 0; j < c.g.light.count; ++j) size = std::max(size, (c.g.light.vertices[i] - c.g.light.vertices[j]).norm());
+      }
+      s.tolerance = std::max(1e-6L, 64 * Real(std::numeric_limits<float>::epsilon()) * (1 + d / size));
+      s.tolerance_note = "float input rounding: 64 eps (1 + distance / size)";
+    }
+    return s;
+  };
+  r.add(std::move(k));
+}
+
+template <template <class> class K>
+void add_all_scalars(Registry& r, const char* kernel, const PolygonConfig& c, Measure m) {
+  add_case<K, float>(r, kernel, c, m);
+  add_case<K, double>(r, kernel, c, m);
+  add_case<K, Real>(r, kernel, c, m);
+}
+
+}  // namespace
+
+void register_polygon_kernels(Registry& r) {
+  for (const PolygonConfig& c : configs()) {
+    add_all_scalars<ProjectedKernel>(r, "polygon-projected-solid-angle", c, Measure::kProjected);
+    add_all_scalars<BiasedKernel>(r, "polygon-projected-solid-angle-biased", c, Measure::kProjected);
+    add_all_scalars<SolidAngleUnclipped>(r, "polygon-solid-angle", c, Measure::kSolid);
+    add_all_scalars<SolidAngleClipped>(r, "polygon-solid-angle-clipped", c, Measure::kSolidClipped);
+    add_all_scalars<ArvoKernel>(r, "baseline-arvo-triangle", c, Measure::kSolid);
+    add_all_scalars<TurkKernel>(r, "baseline-turk-area", c, Measure::kArea);
+    if (c.rectangle) add_all_scalars<UrenaKernel>(r, "baseline-urena-rectangle", c, Measure::kSolid);
+  }
+  // Known limitations (measured; see the issue report): set on the matching cases.
+}
+
+}  // namespace warpcheck::validation
