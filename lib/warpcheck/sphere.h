@@ -67,7 +67,10 @@ template <class T> SphereView<T> make_sphere_view(const SphereLightGeometry<T>& 
   v.cos_theta_max = cos_max;
   // 1 - cos = sin^2 / (1 + cos): no cancellation for tiny cones.
   v.one_minus_cos_max = v.sin2_theta_max / (T(1) + cos_max);
-  if (!(v.one_minus_cos_max > T(0))) return v.reason = NoSample::kTooSmall, v;
+  // The density 1 / (2 pi (1 - cos)) must be representable too: r / d ~ 4e-155 in double gives a subnormal
+  // 1 - cos ~ 7e-310 whose density overflows to Inf (found by fuzz_sphere_double, issue 7).
+  if (!(v.one_minus_cos_max > T(0)) || !std::isfinite(T(1) / (kTwoPi<T> * v.one_minus_cos_max)))
+    return v.reason = NoSample::kTooSmall, v;
   // Entirely below the horizon: the angle between the normal and the axis is at least pi/2 + theta_max,
   // i.e. n.axis <= -sin(theta_max).
   if (v.normal.dot(v.frame.z) <= -s) return v.reason = NoSample::kBelowHorizon, v;

@@ -8,6 +8,7 @@
 
 #include "commands.h"
 #include "warpcheck/validation/battery.h"
+#include "warpcheck/validation/negative_controls.h"
 #include "warpcheck/validation/registry.h"
 
 namespace warpcheck::cli {
@@ -67,7 +68,7 @@ const char* kListHelp =
 const char* kValidateHelp =
     "usage: warpcheck validate [--kernel GLOB]... [--config GLOB]... [--scalar GLOB]... [--samples N]\n"
     "                          [--seed S] [--alpha A] [--correction holm|sidak] [--threads N] [--json FILE]\n"
-    "                          [--quiet]\n"
+    "                          [--quiet] [--negative-controls]\n"
     "\n"
     "Runs the battery (chi2, ks-radial, ks-azimuth, pdf-integral, pdf-consistency, normalization:*) on every\n"
     "selected kernel and configuration and prints a table: kernel, scalar, config, test, statistic, p-value,\n"
@@ -84,6 +85,8 @@ const char* kValidateHelp =
     "  --json FILE       also write {\"alpha\",\"correction\",\"results\":[...]}; rewritten atomically after each\n"
     "                    case with \"complete\": false, so a killed run keeps what it finished\n"
     "  --quiet           no progress on stderr\n"
+    "  --negative-controls  run the deliberately broken samplers instead of the registered kernels (each\n"
+    "                    must FAIL; the exit status is then 1 when the battery works)\n"
     "\n"
     "Exit status: 0 when every test passes (documented known limitations excepted), 1 when any fails, 2 on\n"
     "bad arguments.\n";
@@ -139,7 +142,7 @@ int validate_main(const std::vector<std::string>& a) {
   double alpha = 0.01;
   Correction corr = Correction::kHolm;
   std::string json;
-  bool quiet = false;
+  bool quiet = false, negative = false;
   for (std::size_t i = 0; i < a.size(); ++i) {
     const std::string& f = a[i];
     auto value = [&]() -> const std::string& {
@@ -168,11 +171,13 @@ int validate_main(const std::vector<std::string>& a) {
       if (json.empty()) throw UsageError("--json needs a file name");
     } else if (f == "--quiet") {
       quiet = true;
+    } else if (f == "--negative-controls") {
+      negative = true;
     } else {
       throw UsageError("unknown option '" + f + "'");
     }
   }
-  const Registry reg = default_registry();
+  const Registry reg = negative ? negative_control_registry() : default_registry();
   const std::vector<const Case*> cases = select_cases(reg, sel);
   if (!json.empty()) {  // fail on an unwritable path now, not after an hour of work
     std::ofstream probe(json, std::ios::app);

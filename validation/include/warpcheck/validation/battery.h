@@ -37,6 +37,11 @@ struct TestResult {
   bool passed = false;            // for statistical tests: set by apply_correction
   std::string detail;             // human-readable: dof, pooled bins, tolerance, worst point, ...
   std::string known_limitation;   // non-empty: a documented expected failure; it does not fail a run
+  // chi2 only: the grid over the bounding cap, row-major [radial][azimuth] (radial row r covers
+  // t = (1 - cos theta)/(1 - cos theta_max) in [r/R, (r+1)/R), column a covers phi in [2 pi a/A, 2 pi (a+1)/A)),
+  // observed counts and expected counts (n * bin mass) before pooling; empty for other tests.
+  int map_rows = 0, map_cols = 0;
+  std::vector<double> observed, expected;
 };
 
 struct BatteryOptions {
@@ -44,7 +49,8 @@ struct BatteryOptions {
   std::uint64_t seed = 1;
   int radial_bins = 16, azimuth_bins = 32;  // chi-square grid: 512 equal-area bins over the bounding cap
   double min_expected = 5;                  // bins expected to hold fewer samples are pooled
-  int ks_cdf_nodes = 8192;                  // nodes of the quadrature-computed marginal CDFs
+  int ks_cdf_nodes = 1024;                  // nodes of the quadrature-computed marginal CDFs (D is taken there)
+  double quadrature_tolerance = 1e-8;       // relative tolerance of every region integral (see integrate_cap_region)
   int consistency_points = 2048;            // primary-sample points of the pdf/Jacobian check
   int threads = 0;                          // 0: hardware concurrency
   // Called with (phase, fraction done) during long work; may be empty.
@@ -74,10 +80,21 @@ std::vector<TestResult> validate(const SamplerUnderTest& s, const BatteryOptions
 
 // ---- Building blocks, exposed for tests -----------------------------------------------------------------
 
+struct QuadratureResult {
+  Real value = 0, error = 0;  // error: the rule's own estimate (|K15 - G7| summed over panels)
+};
+
+// Globally adaptive Gauss-Kronrod on [a, b]: splits the panel with the largest error until the summed error
+// is at most max(abs_tol, rel_tol |value|) or max_panels panels exist. Never loops forever on noisy f.
+QuadratureResult integrate_adaptive(const std::function<Real(Real)>& f, Real a, Real b, Real rel_tol, Real abs_tol,
+                                    int max_panels);
+
 // Integral of f over the region {w : t in [t0, t1], phi in [phi0, phi1]} of a cap's frame, where
 // t = (1 - cos theta) / cap.one_minus_cos (so t in [0, 1] spans the cap; t up to 2 / one_minus_cos reaches
-// the antipode), by nested adaptive Gauss-Kronrod in long double. Copes with jumps of f inside the region by
-// bisection (Boost's gauss_kronrod with a deep max_depth), to relative accuracy ~tol.
+// the antipode), by nested globally adaptive Gauss-Kronrod in long double, to relative accuracy ~tol where the
+// panel budget allows (a jump of f across the region, a light's edge, costs ~30 bisections per line).
+QuadratureResult integrate_cap_region_with_error(const std::function<Real(const Vec3L&)>& f, const Cap<Real>& cap,
+                                                 Real t0, Real t1, Real phi0, Real phi1, Real tol = 1e-10L);
 Real integrate_cap_region(const std::function<Real(const Vec3L&)>& f, const Cap<Real>& cap, Real t0, Real t1,
                           Real phi0, Real phi1, Real tol = 1e-10L);
 

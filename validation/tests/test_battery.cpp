@@ -1,0 +1,185 @@
+// Specifications of the battery's building blocks: quadrature accuracy on densities with jumps, the
+// family-wise corrections, KS at nodes, determinism.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "warpcheck/validation/battery.h"
+
+namespace warpcheck::validation {
+namespace {
+
+const Cap<Real> kBounding{Vec3L(0, 0, 1), Real(0.3)};  // half-angle 45.6 deg, the chi-square grid's cap
+
+// Uniform density on a second cap C2 (axis tilted by beta in the xz plane, half-angle alpha) that lies inside the
+// bounding cap and whose edge cuts the grid's bins obliquely: the hardest case for bin quadrature, a jump along
+// a curve.
+struct TiltedCap {
+  Real beta = Real(0.25), alpha = Real(0.3);
+  Vec3L axis() const { return Vec3L(std::sin(beta), 0, std::cos(beta)); }
+  Real density() const { return 1 / (kTwoPi<Real> * (1 - std::cos(alpha))); }
+  Real pdf(const Vec3L& w) const { return w.dot(axis()) >= std::cos(alpha) ? density() : 0; }
+  // Exact mass of the bin t in [t0, t1], phi in [phi0, phi1] of kBounding, computed independently of
+  // integrate_cap_region: for fixed phi the set of polar angles theta inside C2 solves
+  //   sin(theta) cos(phi) sin(beta) + cos(theta) cos(beta) = R cos(theta - delta) >= cos(alpha)
+  // in closed form, |theta - delta| <= acos(cos(alpha) / R); the mass of that theta-interval is the
+  // difference of cosines. Only the smooth outer integral over phi is numerical (with a 4000-panel budget
+  // and a 1e-15 tolerance, far beyond the accuracy being tested).
+  Real bin_mass(Real t0, Real t1, Real phi0, Real phi1) const {
+    const Real th0 = std::acos(1 - t0 * kBounding.one_minus_cos), th1 = std::acos(1 - t1 * kBounding.one_minus_cos);
+    auto inner = [&](Real phi) -> Real {
+      const Real A = std::cos(phi) * std::sin(beta), B = std::cos(beta);
+      const Real R = std::hypot(A, B), delta = std::atan2(A, B);
+      if (std::cos(alpha) > R) return 0;
+      const Real gamma = std::acos(std::cos(alpha) / R);
+      const Real lo = std::max(th0, delta - gamma), hi = std::min(th1, delta + gamma);
+      return hi > lo ? (std::cos(lo) - std::cos(hi)) * density() : Real(0);
+    };
+    return integrate_adaptive(inner, phi0, phi1, 1e-15L, 1e-20L, 4000).value;
+  }
+};
+
+TEST(BinQuadrature, ExpectedCountsOfADensityWithAnObliqueJumpAreAccurateToOneInAMillion) {
+  const TiltedCap c;
+  ASSERT_LE(c.beta + c.alpha, std::acos(1 - kBounding.one_minus_cos));  // C2 inside the bounding cap
+  const BatteryOptions o;  // the battery's default grid and quadrature tolerance
+  const int R = o.radial_bins, A = o.azimuth_bins;
+  const Real mean_mass = Real(1) / (R * A);
+  Real total = 0, worst_rel = 0;
+  int cut_bins = 0;
+  for (int ri = 0; ri < R; ++ri)
+    for (int ai = 0; ai < A; ++ai) {
+      const Real t0 = Real(ri) / R, t1 = Real(ri + 1) / R;
+      const Real p0 = kTwoPi<Real> * ai / A, p1 = kTwoPi<Real> * (ai + 1) / A;
+      const Real exact = c.bin_mass(t0, t1, p0, p1);
+      const Real quad = integrate_cap_region([&](const Vec3L& w) { return c.pdf(w); }, kBounding, t0, t1, p0, p1,
+                                             Real(o.quadrature_tolerance));
+      total += exact;
+      // Relative to the bin's own mass; bins the edge barely clips (mass below 1e-3 of the average bin, fewer
+      // than 20 expected samples at 1e7) are held to 1e-6 of the average bin's mass instead.
+      const Real scale = std::max(exact, mean_mass * Real(1e-3));
+      worst_rel = std::max(worst_rel, std::abs(quad - exact) / scale);
+      if (exact > 0 && exact < 0.999L * c.density() * (p1 - p0) * (t1 - t0) * kBounding.one_minus_cos) ++cut_bins;
+    }
+  EXPECT_NEAR(double(total), 1.0, 1e-12);  // the reference itself is right
+  EXPECT_GT(cut_bins, 20);                 // the jump crosses many bins
+  EXPECT_LT(double(worst_rel), 1e-6);
+  RecordProperty("worst_relative_error", std::to_string(double(worst_rel)));
+}
+
+TEST(BinQuadrature, InverseSquareRootSingularityAtTheCapsEdgeIsIntegratedToOneInAMillion) {
+  // f = 1 / sqrt(1 - t) on the cap (the visible-area sampler's silhouette behaviour); ring mass exact:
+  // integral of (1 - t)^(-1/2) dt = 2 (sqrt(1 - t0) - sqrt(1 - t1)), times omc and the azimuth range.
+  auto f = [](const Vec3L& w) {
+    const Real t = (w - kBounding.axis).squaredNorm() / 2 / kBounding.one_minus_cos;
+    return t < 1 ? 1 / std::sqrt(1 - t) : Real(0);
+  };
+  for (Real t0 : {Real(0), Real(0.5), Real(0.9375)}) {
+    const Real t1 = t0 == 0 ? Real(1) : t0 == Real(0.5) ? Real(0.75) : Real(1);
+    const Real exact = 2 * (std::sqrt(1 - t0) - std::sqrt(1 - t1)) * kBounding.one_minus_cos * Real(0.5);
+    const Real quad = integrate_cap_region(f, kBounding, t0, t1, 1, Real(1.5), 1e-8L);
+    EXPECT_LT(double(std::abs(quad / exact - 1)), 1e-6) << double(t0);
+  }
+}
+
+TEST(AdaptiveQuadrature, StopsAtItsPanelBudgetOnPureNoiseInsteadOfRunningForever) {
+  std::uint64_t state = 1;
+  auto noise = [&](Real) {
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    return Real(state >> 11) * 0x1.0p-53L;
+  };
+  const QuadratureResult r = integrate_adaptive(noise, 0, 1, 1e-12L, 0, 100);
+  EXPECT_GT(double(r.error), 1e-12);  // it says it did not converge
+  EXPECT_NEAR(double(r.value), 0.5, 0.05);
+}
+
+TestResult stat(double p) {
+  TestResult r;
+  r.p_value = p;
+  return r;
+}
+
+TEST(Correction, SidakRejectsExactlyBelowOneMinusOneMinusAlphaToTheOneOverM) {
+  std::vector<TestResult> r = {stat(0.0025), stat(0.0026), stat(0.5), stat(0.9)};
+  TestResult det;  // deterministic results do not count in m
+  det.passed = true;
+  r.push_back(det);
+  // m = 4, alpha 0.01: threshold 1 - 0.99^(1/4) = 0.0025094...
+  EXPECT_EQ(apply_correction(r, 0.01, Correction::kSidak), 4u);
+  EXPECT_FALSE(r[0].passed);
+  EXPECT_TRUE(r[1].passed);
+  EXPECT_TRUE(r[2].passed && r[3].passed && r[4].passed);
+}
+
+TEST(Correction, HolmStepsDownAndStopsAtTheFirstAcceptance) {
+  // alpha 0.01, m = 4: thresholds 0.0025, 0.00333, 0.005, 0.01 for the sorted p-values.
+  std::vector<TestResult> r = {stat(0.004), stat(0.0024), stat(0.0049), stat(0.009)};
+  apply_correction(r, 0.01, Correction::kHolm);
+  EXPECT_FALSE(r[1].passed);  // 0.0024 <= 0.0025
+  EXPECT_TRUE(r[0].passed);   // 0.004 > 0.00333: stop; everything after is accepted
+  EXPECT_TRUE(r[2].passed);
+  EXPECT_TRUE(r[3].passed);
+}
+
+SamplerUnderTest uniform_cone() {
+  SamplerUnderTest s;
+  s.kernel = "uniform-cone", s.scalar = "long double", s.config = "test";
+  s.bounding_cap = kBounding;
+  const Real density = 1 / kBounding.solid_angle();
+  s.sample = [density](double u0, double u1) {
+    return Sample{cap_direction(kBounding, Real(u0), kTwoPi<Real> * Real(u1)), density, true};
+  };
+  s.pdf = [density](const Vec3L& w) { return kBounding.contains(w, 1e-15L) ? density : Real(0); };
+  return s;
+}
+
+TEST(Battery, IsDeterministicForAGivenSeedWhateverTheThreadCount) {
+  BatteryOptions a, b;
+  a.samples = b.samples = 100'000;
+  a.threads = 1, b.threads = 2;
+  const auto ra = run_battery(uniform_cone(), a), rb = run_battery(uniform_cone(), b);
+  ASSERT_EQ(ra.size(), rb.size());
+  for (std::size_t k = 0; k < ra.size(); ++k) {
+    EXPECT_EQ(ra[k].statistic, rb[k].statistic) << ra[k].test;
+    EXPECT_EQ(ra[k].p_value, rb[k].p_value) << ra[k].test;
+  }
+}
+
+TEST(Battery, AcceptsAnExactUniformConeAndReportsEveryTest) {
+  BatteryOptions o;
+  o.samples = 1'000'000;
+  const auto r = validate(uniform_cone(), o);
+  std::vector<std::string> tests;
+  for (const auto& x : r) tests.push_back(x.test);
+  EXPECT_EQ(tests, (std::vector<std::string>{"chi2", "ks-radial", "ks-azimuth", "pdf-integral", "pdf-consistency"}));
+  EXPECT_TRUE(all_passed(r)) << format_table(r);
+}
+
+TEST(Battery, RejectsMalformedSamplersWithAClearError) {
+  SamplerUnderTest s = uniform_cone();
+  s.bounding_cap.one_minus_cos = 0;
+  EXPECT_THROW(run_battery(s, {}), std::invalid_argument);
+  s = uniform_cone();
+  s.pdf = nullptr;
+  EXPECT_THROW(run_battery(s, {}), std::invalid_argument);
+  BatteryOptions o;
+  o.samples = 10;
+  EXPECT_THROW(run_battery(uniform_cone(), o), std::invalid_argument);
+}
+
+TEST(Json, HoldsAlphaCorrectionAndNullPValuesForDeterministicTests) {
+  TestResult det;
+  det.kernel = "k", det.scalar = "double", det.config = "c", det.test = "pdf-integral", det.statistic = 1e-17;
+  det.passed = true;
+  std::vector<TestResult> r = {stat(0.5), det};
+  r[0].test = "chi2";
+  apply_correction(r, 0.01, Correction::kHolm);
+  const std::string j = to_json(r, 0.01, Correction::kHolm);
+  EXPECT_NE(j.find("\"alpha\":0.01"), std::string::npos) << j;
+  EXPECT_NE(j.find("\"correction\":\"holm\""), std::string::npos);
+  EXPECT_NE(j.find("\"p_value\":null"), std::string::npos);
+  EXPECT_NE(j.find("\"p_value\":0.5"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace warpcheck::validation
