@@ -1,0 +1,456 @@
+// warpcheck/projected_cap.h: sphere lights sampled by projected solid angle (Peters & Dachsbacher 2019,
+// "Sampling Projected Spherical Caps in Real Time", HPG 2019; "the paper" below).
+//
+// Local frame (Alg. 1): z = n, x = horizontal direction towards the centre, y = z x x. The cap's boundary circle
+// projects to an ellipse in the xy-plane with centre (c_x, 0), half-axes |r_x|, r_y; the projected cap P is
+// cut into pieces that are each a cut unit disk (Alg. 5) mapped affinely (Cases 1-2, Alg. 2-3) or by the
+// Case-3 warp (Alg. 4) onto P. Cases, by the height h = n.w_d of the unit direction w_d to the centre and
+// r_y = sin(theta_max) = r / |d|:
+//   Case 1 h >= r_y (entirely above), Case 2 0 <= h < r_y, Case 3 -r_y < h < 0, Case 4 h <= -r_y (no sample).
+//
+// Conventions the paper leaves implicit, derived here (the supplement is not available):
+//  * SampleCutUnitDisk's argument. Alg. 5 states an "offset area A in [-pi/2, pi/2]", but Alg. 2-4 pass areas
+//    in [0, pi] (pi xi_0 in Alg. 3, A_E' up to pi in Alg. 2). The only reading under which Alg. 2 is continuous
+//    at its threshold (the ellipse piece ends at x = t_x where the mirrored disk piece begins) is that the
+//    argument is the area LEFT of d_x, a in [0, pi], and Alg. 5's A is a - pi/2. We implement that.
+//  * Numerically stable forms (no cancellation near the case boundaries), all exact algebra on Alg. 1:
+//      t_x = v / w_dx, t_y = sqrt((r_y - |h|)(r_y + |h|)) / w_dx         (from t_y^2 = 1 - t_x^2, v^2 = 1 - r_y^2)
+//      X_t = (t_x - c_x) / r_x = v h / (r_y w_dx), sqrt(1 - X_t^2) = sqrt(r_y^2 - h^2) / (r_y w_dx)
+//      c_z + r_z = (r_y^2 - h^2) / (w_dx r_y - h v)                       (Case 3: h < 0, no cancellation)
+//      s_y^2 = r_y^2 (c_z + r_z)(r_z - c_z + w_z) / (t_y r_z^2 (t_y + d_z))  (Alg. 4's s_y with the common factor
+//              (t_y - d_z) cancelled: no 0/0 at the top of the lune, no clamping needed there)
+//    and areas of cut disks from angles: the unit disk's area right of x = cos(theta) is
+//      C(theta) = theta - sin(theta) cos(theta) = (2 theta - sin 2 theta) / 2,
+//    evaluated by its Taylor series for small theta (it is ~ 2 theta^3 / 3; the difference form cancels).
+//  * The quintic (Alg. 5) is not an exact inverse of A(X), so the warp it defines is not exactly uniform. Its
+//    density is known in closed form: with q(s) = g(s) (pi/2 - s)^(2/3) and e = pi/2 - s, the cut disk point
+//    has density (per unit disk area, per unit left-area) 1 / (X'(a) 2 sqrt(1 - X^2)) =
+//      1 / (2 ((2/3) g - g' e) sqrt(g) sqrt(2 - q))
+//    instead of 1. It is also not monotone at a = pi/2 (X(pi/2 +- 0) = -+4.6e-5: a fold, points with
+//    |d_x| < 4.6e-5 are reached twice) and the pieces' ends do not meet exactly (overlaps / gaps of relative
+//    width ~0.3% of 1 - |t_x| at the Case-2 seam and the top of the Case-3 lune). We therefore report the
+//    TRUE density of the implemented warp: the sum, over every piece and every branch of the quintic that
+//    reaches the direction, of its density. CutDiskInverse::kExact replaces the quintic by the exact inverse
+//    of A(X) (Boost.Math Newton iteration), for which the paper's densities hold exactly (Cases 1-2 uniform).
+//  * pdf is per solid angle: the paper's density p w.r.t. projected solid angle times cos = n.w.
+#pragma once
+
+#include <boost/math/tools/roots.hpp>
+#include <array>
+#include <cstdint>
+
+#include "warpcheck/core.h"
+#include "warpcheck/sphere.h"
+
+namespace warpcheck {
+
+enum class CutDiskInverse { kQuintic, kExact };
+
+// ---- Cut unit disks (Sec. 3.6) ----------------------------------------------------------------------------
+
+// Area of the unit disk right of x = cos(theta), theta in [0, pi/2]: C = theta - sin cos = (phi - sin phi) / 2,
+// phi = 2 theta. Hand-rolled series for phi < 1 because the difference cancels (no library has x - sin x).
+template <class T> T cut_disk_area_from_angle(T theta) {
+  const T phi = T(2) * theta;
+  if (phi < T(1)) {
+    // (phi - sin phi) / 2 = sum_{k>=1} (-1)^(k+1) phi^(2k+1) / (2 (2k+1)!); 12 terms reach 1e-25 relative.
+    const T p2 = phi * phi;
+    T term = phi * p2 / T(6), sum = T(0);
+    for (int k = 1; k <= 12; ++k) {
+      sum += term;
+      term *= -p2 / T((2 * k + 2) * (2 * k + 3));
+    }
+    return sum / T(2);
+  }
+  return (phi - std::sin(phi)) / T(2);
+}
+
+// The area of the unit disk left of x, pi/2 + A(x) with A of Sec. 3.3, given x and its half-height
+// hh = sqrt(1 - x^2) (both known accurately by the caller): pi - C(theta) for x = cos(theta) >= 0.
+template <class T> T unit_disk_area_left_of(T x, T hh) {
+  const T theta = std::atan2(std::max(hh, T(0)), std::abs(x));  // angle of |x| = cos(theta)
+  const T right_of_abs = cut_disk_area_from_angle(theta);
+  return x >= T(0) ? kPi<T> - right_of_abs : right_of_abs;
+}
+
+// The quintic g of Alg. 5 (Horner) and its derivative.
+template <class T> T quintic_g(T s) {
+  return (((((T(-0.0079908617) * s + T(0.0238255409)) * s - T(0.0283903598)) * s + T(0.0198450184)) * s -
+           T(0.0574433620)) * s + T(0.7400712465));
+}
+template <class T> T quintic_g_prime(T s) {
+  return ((((T(5) * T(-0.0079908617) * s + T(4) * T(0.0238255409)) * s - T(3) * T(0.0283903598)) * s +
+           T(2) * T(0.0198450184)) * s - T(0.0574433620));
+}
+
+// A point's abscissa in the unit disk with its half-height sqrt(1 - x^2), computed without cancellation.
+template <class T> struct CutDiskX {
+  T x = T(0);
+  T half_height = T(1);
+  T density = T(1);  // density of x per unit disk area when the left-area is uniform (1 for the exact inverse)
+};
+
+// Exact inverse of the left-area: solves C(theta) = target (target in [0, pi/2]) for theta in [0, pi/2] by
+// Boost.Math's safeguarded Newton iteration (C' = 2 sin^2 theta).
+template <class T> T solve_cut_disk_angle(T target) {
+  if (!(target > T(0))) return T(0);
+  if (target >= kPi<T> / T(2)) return kPi<T> / T(2);
+  // Start from the small-angle asymptote C ~ 2 theta^3 / 3, clamped into the bracket.
+  const T guess = std::min(std::cbrt(T(1.5) * target), kPi<T> / T(2));
+  std::uintmax_t iterations = 60;
+  return boost::math::tools::newton_raphson_iterate(
+      [target](T th) {
+        const T s = std::sin(th);
+        return std::make_pair(cut_disk_area_from_angle(th) - target, T(2) * s * s);
+      },
+      guess, T(0), kPi<T> / T(2), std::numeric_limits<T>::digits - 2, iterations);
+}
+
+// Density factor of the quintic at distance e = pi/2 - |a - pi/2| from the nearest end of the area range
+// (derived above): 1 / (2 ((2/3) g - g' e) sqrt(g) sqrt(2 - q)), q = g e^(2/3).
+template <class T> T quintic_density(T s, T e) {
+  const T g = quintic_g(s), gp = quintic_g_prime(s);
+  const T q = g * std::cbrt(e * e);
+  return T(1) / (T(2) * (T(2) / T(3) * g - gp * e) * std::sqrt(g) * std::sqrt(std::max(T(0), T(2) - q)));
+}
+
+// SampleCutUnitDisk (Alg. 5), abscissa only: the point whose left-area is `left_area` in [0, pi].
+template <class T, CutDiskInverse M> CutDiskX<T> sample_cut_unit_disk_x(T left_area) {
+  const T a = std::clamp(left_area, T(0), kPi<T>);
+  const T e = std::min(a, kPi<T> - a);  // pi/2 - |A| of Alg. 5, without cancellation near the ends
+  const bool positive = a >= kPi<T> / T(2);
+  CutDiskX<T> out;
+  if constexpr (M == CutDiskInverse::kQuintic) {
+    const T s = kPi<T> / T(2) - e;  // |A|
+    const T q = quintic_g(s) * std::cbrt(e * e);
+    const T m = T(1) - q;  // |d_x| before the sign (negative inside the fold near a = pi/2)
+    out.x = positive ? m : -m;
+    out.half_height = std::sqrt(std::max(T(0), q * (T(2) - q)));  // sqrt(1 - m^2) = sqrt((1 - m)(1 + m))
+    out.density = quintic_density(s, e);
+  } else {
+    const T theta = solve_cut_disk_angle(e);  // C(theta) = e: the area beyond |x| = cos(theta)
+    out.x = positive ? std::cos(theta) : -std::cos(theta);
+    out.half_height = std::sin(theta);
+  }
+  return out;
+}
+
+// Every left-area a in [0, pi] whose cut-disk abscissa is x (half-height hh), with the density there. The
+// exact inverse has one; the quintic has one per branch (a < pi/2, a >= pi/2) that reaches x, i.e. two inside
+// the fold |x| < X(pi/2 - 0). Returns the count.
+template <class T> struct CutDiskPreimage {
+  T left_area;
+  T density;
+};
+template <class T, CutDiskInverse M> int cut_disk_preimages(T x, T hh, std::array<CutDiskPreimage<T>, 2>& out) {
+  if constexpr (M == CutDiskInverse::kExact) {
+    out[0] = {unit_disk_area_left_of(x, hh), T(1)};
+    return 1;
+  } else {
+    // Branch a >= pi/2: x = 1 - q(s); branch a < pi/2: x = -(1 - q(s)); q decreases from q(0) = 1.0000463 to 0.
+    // Solve q = target in t = e^(1/3) (q = g(pi/2 - t^3) t^2 is smooth in t, so Newton converges near the
+    // disk's edge where dX/da is infinite).
+    const T t_max = std::cbrt(kPi<T> / T(2));
+    const T q0 = quintic_g(T(0)) * t_max * t_max;
+    int n = 0;
+    for (int branch = 0; branch < 2; ++branch) {
+      const bool positive = branch == 0;
+      // 1 - x for the positive branch, 1 + x for the negative one; from hh when that is more accurate.
+      const T ax = positive ? x : -x;
+      T target = ax > T(0.5) ? hh * hh / (T(1) + ax) : T(1) - ax;
+      if (!(target <= q0)) continue;
+      target = std::max(target, T(0));
+      const T guess = std::min(std::sqrt(target / quintic_g(kPi<T> / T(2))), t_max);
+      std::uintmax_t iterations = 60;
+      const T t = boost::math::tools::newton_raphson_iterate(
+          [target](T t) {
+            const T t3 = t * t * t, s = kPi<T> / T(2) - t3;
+            const T g = quintic_g(s), gp = quintic_g_prime(s);
+            return std::make_pair(g * t * t - target, t * (T(2) * g - T(3) * t3 * gp));
+          },
+          guess, T(0), t_max, std::numeric_limits<T>::digits - 2, iterations);
+      const T e = t * t * t, s = kPi<T> / T(2) - e;
+      out[n++] = {positive ? kPi<T> - e : e, quintic_density(s, e)};
+    }
+    return n;
+  }
+}
+
+// ---- ComputeGeometry (Alg. 1) and the per-light precomputation (Sec. 3.7) ----------------------------------
+
+template <class T> struct ProjectedCapView {
+  NoSample reason = NoSample::kNone;
+  int which_case = 4;   // 1: entirely above, 2: mostly above, 3: mostly below (Sec. 3.2)
+  SphereView<T> sphere;  // validation, distance, the cap (shared with the sphere kernels)
+  Vec3<T> x, y, z;       // local frame (Alg. 1)
+  T h = T(0), w_dx = T(0);  // n.w_d and the horizontal length of w_d
+  T r_x = T(0), r_y = T(0), r_z = T(0), c_x = T(0), c_z = T(0), t_x = T(0), t_y = T(0), v = T(0);
+  // Pieces: ellipse (Cases 1-2, u0 in [0, tau)), mirrored disk (Case 2, u0 in [tau, 1]), lune (Case 3).
+  T area_e = T(0), area_e_unit = T(0), area_d = T(0), total = T(0), tau = T(0);
+  // Case 3: z scale k = (c_z + r_z) / t_y, c_z + r_z and r_z - c_z.
+  T k = T(0), top = T(0), rz_minus_cz = T(0);
+
+  bool valid() const { return reason == NoSample::kNone; }
+  Vec3<T> to_world(const Vec3<T>& w) const { return w.x() * x + w.y() * y + w.z() * z; }
+  Vec3<T> to_local(const Vec3<T>& w) const { return Vec3<T>(w.dot(x), w.dot(y), w.dot(z)); }
+  // The normaliser of Cases 1-2 (A_E + A_D, the projected solid angle); Case 3 has none (non-uniform density).
+  T projected_solid_angle_if_uniform() const { return which_case <= 2 ? total : T(0); }
+};
+
+template <class T> ProjectedCapView<T> make_projected_cap_view(const SphereLightGeometry<T>& g) {
+  ProjectedCapView<T> p;
+  p.sphere = make_sphere_view(g);
+  if (!p.sphere.valid()) return p.reason = p.sphere.reason, p;
+  const SphereView<T>& s = p.sphere;
+  const Vec3<T> wd = s.frame.z;
+  p.z = s.normal;
+  // The horizontal part of w_d by two Gram-Schmidt passes with the UNclamped height: for a light (nearly) overhead
+  // the true horizontal part can be far below eps, and one pass (or subtracting the clamped height, when the
+  // rounded w_d has n.w_d = 1 + ulp) leaves a rounding residue ~eps along n that outweighs it, turning x towards
+  // n (found by the worst-case search precision-sphere-projected-cap-double-angle: long double x came out
+  // (-0.225, 0, 0.974) for an overhead light, 0.65 rad between the double and long double samples). The second
+  // pass removes the residue along n, so x is horizontal to rounding and as accurate as w_d's own horizontal
+  // components (exact for an axis-aligned normal). No threshold below which x is replaced: a threshold depends
+  // on eps_T, so float/double and long double would choose different x's between their thresholds, which is
+  // the same O(1) rotation of the samples this fixes; x is replaced only when the horizontal part is exactly 0.
+  const T h_raw = p.z.dot(wd);
+  Vec3<T> horizontal = wd - h_raw * p.z;
+  horizontal -= horizontal.dot(p.z) * p.z;
+  p.h = std::clamp(h_raw, T(-1), T(1));
+  p.w_dx = horizontal.stableNorm();
+  p.x = p.w_dx > T(0) ? Vec3<T>(horizontal / p.w_dx) : Frame<T>::from_z(p.z).x;  // overhead: any horizontal x
+  p.y = p.z.cross(p.x);
+  p.r_y = std::sqrt(s.sin2_theta_max);
+  p.v = s.cos_theta_max;
+  p.r_x = p.h * p.r_y, p.r_z = p.w_dx * p.r_y, p.c_x = p.w_dx * p.v, p.c_z = p.h * p.v;
+  const T h = p.h, ry = p.r_y, v = p.v;
+  if (h <= -ry) return p.reason = NoSample::kBelowHorizon, p;  // Case 4 (make_sphere_view catches it first)
+  if (h >= ry) {
+    // Case 1 (Alg. 3): the whole ellipse; t_x >= 1 is never needed.
+    p.which_case = 1;
+    p.area_e_unit = kPi<T>;
+    p.area_e = p.r_x * p.r_y * kPi<T>;
+    p.total = p.area_e;
+    p.tau = T(1);
+  } else {
+    const T chord2 = (ry - std::abs(h)) * (ry + std::abs(h));  // r_y^2 - h^2 > 0
+    p.t_x = v / p.w_dx;                                       // w_dx >= v > 0 here
+    p.t_y = std::sqrt(chord2) / p.w_dx;
+    p.area_d = cut_disk_area_from_angle(std::atan2(std::sqrt(chord2), v));  // pi/2 - A(t_x)
+    if (h >= T(0)) {
+      // Case 2 (Alg. 2). A_E' = pi/2 + A(X_t) = pi - C(theta_E), X_t = cos(theta_E) = v h / (r_y w_dx).
+      p.which_case = 2;
+      p.area_e_unit = kPi<T> - cut_disk_area_from_angle(std::atan2(std::sqrt(chord2), v * h));
+      p.area_e = p.r_x * p.r_y * p.area_e_unit;
+      p.total = p.area_e + p.area_d;
+      p.tau = p.area_e / p.total;
+    } else {
+      // Case 3 (Alg. 4).
+      p.which_case = 3;
+      p.rz_minus_cz = p.w_dx * ry - h * v;
+      p.top = chord2 / p.rz_minus_cz;                          // c_z + r_z
+      p.k = std::sqrt(chord2) * p.w_dx / p.rz_minus_cz;        // (c_z + r_z) / t_y
+      p.total = p.area_d;
+      p.tau = T(0);
+    }
+  }
+  if (!(p.total > T(0)) || !std::isfinite(p.total)) return p.reason = NoSample::kTooSmall, p;
+  return p;
+}
+
+// ---- The pieces: cut disk <-> local direction --------------------------------------------------------------
+
+namespace projected_cap_detail {
+
+// Case 3 (Alg. 4): s_y from d_z and w_z = k d_z, in the cancelled form (see the header comment).
+template <class T> T case3_sy(const ProjectedCapView<T>& p, T d_z, T w_z) {
+  const T num = p.r_y * p.r_y * p.top * (p.rz_minus_cz + w_z);
+  const T den = p.t_y * p.r_z * p.r_z * (p.t_y + d_z);
+  return std::sqrt(std::max(T(0), num / den));
+}
+
+// w_z = sqrt(1 - w_x^2 - w_y^2) as sqrt((1 - rho)(1 + rho)).
+template <class T> T lift(T wx, T wy) {
+  const T rho = std::hypot(wx, wy);
+  return std::sqrt(std::max(T(0), (T(1) - rho) * (T(1) + rho)));
+}
+
+// Piece geometry: 0 ellipse, 1 mirrored disk, 2 Case-3 lune. Maps a cut-disk point to a local direction and
+// gives the projected-solid-angle density from the disk density (per unit area and unit u0).
+template <class T> struct Local {
+  Vec3<T> w;
+  T pdf_proj;
+};
+
+template <class T> Local<T> disk_to_local(const ProjectedCapView<T>& p, int piece, T dx, T dy, T disk_density) {
+  Local<T> o;
+  if (piece == 0) {
+    const T wx = p.r_x * dx + p.c_x, wy = p.r_y * dy;
+    o.w = Vec3<T>(wx, wy, lift(wx, wy));
+    o.pdf_proj = disk_density / (p.r_x * p.r_y);
+  } else if (piece == 1) {
+    o.w = Vec3<T>(-dx, dy, lift(dx, dy));
+    o.pdf_proj = disk_density;
+  } else {
+    const T d_z = lift(dx, dy);
+    const T w_z = p.k * d_z;
+    const T s_y = case3_sy(p, d_z, w_z);
+    const T w_y = s_y * dy;
+    const T w_x = lift(w_y, w_z);
+    o.w = Vec3<T>(w_x, w_y, w_z);
+    // Alg. 4: p = -t_y^2 / ((c_z + r_z)^2 A_D) w_x / (d_x s_y) = w_x / (k^2 s_y |d_x|) per unit disk density.
+    o.pdf_proj = disk_density * w_x / (p.k * p.k * s_y * std::abs(dx));
+  }
+  return o;
+}
+
+// Inverse of disk_to_local: the cut-disk point (d_x, d_y) of a local direction w, and the area factor
+// (projected area per disk area); false when w is not in the piece's image of the unit disk.
+template <class T> bool local_to_disk(const ProjectedCapView<T>& p, int piece, const Vec3<T>& w, T& dx, T& dy,
+                                      T& hh, T& area_factor) {
+  if (piece == 0) {
+    if (!(p.r_x > T(0))) return false;
+    dx = (w.x() - p.c_x) / p.r_x, dy = w.y() / p.r_y;
+    area_factor = p.r_x * p.r_y;
+  } else if (piece == 1) {
+    dx = -w.x(), dy = w.y();
+    area_factor = T(1);
+  } else {
+    if (!(w.x() > T(0))) return false;
+    const T d_z = w.z() / p.k;
+    const T s_y = case3_sy(p, d_z, w.z());
+    if (!(s_y > T(0))) return false;
+    dy = w.y() / s_y;
+    const T rest = (T(1) - d_z) * (T(1) + d_z) - dy * dy;
+    if (!(rest >= T(0))) return false;
+    dx = -std::sqrt(rest);
+    area_factor = p.k * p.k * s_y * std::abs(dx) / w.x();
+  }
+  const T rest = (T(1) - std::abs(dx)) * (T(1) + std::abs(dx));
+  if (!(rest >= T(0))) return false;
+  hh = std::sqrt(rest);
+  return std::abs(dy) <= hh && std::isfinite(area_factor) && area_factor > T(0);
+}
+
+// The pieces of a view, with their u0 ranges and left-area maps a = alpha + beta u0.
+template <class T> struct Piece {
+  int kind;
+  T u_lo, u_hi, alpha, beta;
+};
+template <class T> int pieces(const ProjectedCapView<T>& p, std::array<Piece<T>, 2>& out) {
+  switch (p.which_case) {
+    case 1: out[0] = {0, T(0), T(1), T(0), kPi<T>}; return 1;
+    case 2: {
+      int n = 0;
+      // Alg. 2: ellipse a = u0 (A_E + A_D) / A_E * A_E' = u0 total / (r_x r_y); disk a = total (1 - u0).
+      if (p.area_e > T(0)) out[n++] = {0, T(0), p.tau, T(0), p.total / (p.r_x * p.r_y)};
+      out[n++] = {1, p.tau, T(1), p.total, -p.total};
+      return n;
+    }
+    case 3: out[0] = {2, T(0), T(1), p.area_d, -p.area_d}; return 1;
+    default: return 0;
+  }
+}
+
+// Density (per projected solid angle) of local direction w: the sum over pieces and quintic branches.
+// Optionally returns the first preimage (u0, u1).
+template <class T, CutDiskInverse M> T pdf_local(const ProjectedCapView<T>& p, const Vec3<T>& w, Vec2<T>* u = nullptr) {
+  std::array<Piece<T>, 2> ps{};
+  const int n = pieces(p, ps);
+  T sum = T(0);
+  bool found = false;
+  for (int i = 0; i < n; ++i) {
+    const Piece<T>& pc = ps[i];
+    T dx, dy, hh, area;
+    if (!local_to_disk(p, pc.kind, w, dx, dy, hh, area)) continue;
+    std::array<CutDiskPreimage<T>, 2> pre;
+    const int m = cut_disk_preimages<T, M>(dx, hh, pre);
+    const T a_lo = std::min(pc.alpha + pc.beta * pc.u_lo, pc.alpha + pc.beta * pc.u_hi);
+    const T a_hi = std::max(pc.alpha + pc.beta * pc.u_lo, pc.alpha + pc.beta * pc.u_hi);
+    for (int j = 0; j < m; ++j) {
+      if (pre[j].left_area < a_lo || pre[j].left_area > a_hi) continue;
+      sum += pre[j].density / (std::abs(pc.beta) * area);
+      if (u && !found) {
+        found = true;
+        (*u)[0] = std::clamp((pre[j].left_area - pc.alpha) / pc.beta, pc.u_lo, pc.u_hi);
+        (*u)[1] = hh > T(0) ? std::clamp((dy / hh + T(1)) / T(2), T(0), T(1)) : T(0.5);
+      }
+    }
+  }
+  return sum;
+}
+
+}  // namespace projected_cap_detail
+
+// ---- SampleProjectedSphericalCap (Alg. 6), per-sample part ----------------------------------------------------
+
+template <class T, CutDiskInverse M = CutDiskInverse::kQuintic>
+DirectionSample<T> sample_projected_spherical_cap(const ProjectedCapView<T>& p, const Vec2<T>& u) {
+  using namespace projected_cap_detail;
+  if (!p.valid()) return DirectionSample<T>::none(p.reason);
+  if (!std::isfinite(u[0]) || !std::isfinite(u[1])) return DirectionSample<T>::none(NoSample::kNonFinite);
+  const T u0 = std::clamp(u[0], T(0), T(1)), u1 = std::clamp(u[1], T(0), T(1));
+  std::array<Piece<T>, 2> ps{};
+  const int n = pieces(p, ps);
+  int i = 0;
+  while (i + 1 < n && u0 >= ps[i].u_hi) ++i;  // Alg. 2's threshold xi_0 < A_E / (A_E + A_D)
+  const Piece<T>& pc = ps[i];
+  const CutDiskX<T> d = sample_cut_unit_disk_x<T, M>(pc.alpha + pc.beta * u0);  // Alg. 5
+  const T dy = (T(2) * u1 - T(1)) * d.half_height;
+  const Local<T> loc = disk_to_local(p, pc.kind, d.x, dy, d.density / std::abs(pc.beta));
+  T pdf_proj = loc.pdf_proj;
+  if constexpr (M == CutDiskInverse::kQuintic) {
+    // Where another piece or the other branch of the quintic also reaches this direction (the fold at
+    // |d_x| < 4.7e-5 and the Case-2 seam within 4.7e-5 of t_x), the density is the sum: recompute it.
+    const bool near_fold = std::abs(d.x) < T(5e-5);
+    const bool near_seam = p.which_case == 2 && std::abs(loc.w.x() - p.t_x) < T(5e-5);
+    if (near_fold || near_seam) pdf_proj = pdf_local<T, M>(p, loc.w);
+  }
+  const T pdf = pdf_proj * loc.w.z();
+  if (!(pdf > T(0)) || !std::isfinite(pdf)) return DirectionSample<T>::none(NoSample::kOnSilhouette);
+  DirectionSample<T> s;
+  s.direction = p.to_world(loc.w).normalized();
+  s.pdf = pdf;
+  return s;
+}
+
+template <class T, CutDiskInverse M = CutDiskInverse::kQuintic>
+DirectionSample<T> sample_projected_spherical_cap(const SphereLightGeometry<T>& g, const Vec2<T>& u) {
+  return sample_projected_spherical_cap<T, M>(make_projected_cap_view(g), u);
+}
+
+// Density per solid angle of world direction w (the exact density of the implemented warp).
+template <class T, CutDiskInverse M = CutDiskInverse::kQuintic>
+T pdf_projected_spherical_cap(const ProjectedCapView<T>& p, const Vec3<T>& w) {
+  if (!p.valid() || !all_finite(w)) return T(0);
+  const Vec3<T> wl = p.to_local(w.normalized());
+  if (!(wl.z() > T(0))) return T(0);
+  const T pdf = projected_cap_detail::pdf_local<T, M>(p, wl) * wl.z();
+  return std::isfinite(pdf) ? pdf : T(0);
+}
+
+template <class T, CutDiskInverse M = CutDiskInverse::kQuintic>
+T pdf_projected_spherical_cap(const SphereLightGeometry<T>& g, const Vec3<T>& w) {
+  return pdf_projected_spherical_cap<T, M>(make_projected_cap_view(g), w);
+}
+
+// Inverse map: the primary sample (u0, u1) that the warp with inverse M maps to w (the first one, where the
+// quintic's fold or seam reaches w twice). False outside the support. With M = kExact applied to samples of
+// the quintic warp, u0 measures the quintic's error in primary sample space.
+template <class T, CutDiskInverse M = CutDiskInverse::kQuintic>
+bool invert_projected_spherical_cap(const ProjectedCapView<T>& p, const Vec3<T>& w, Vec2<T>& u) {
+  if (!p.valid() || !all_finite(w)) return false;
+  const Vec3<T> wl = p.to_local(w.normalized());
+  if (!(wl.z() >= T(0))) return false;
+  return projected_cap_detail::pdf_local<T, M>(p, wl, &u) > T(0);
+}
+
+// A cap containing every direction the sampler returns: the light's cap, widened by 2% of its 1 - cos for the
+// quintic's overshoot at the Case-2 seam and the top of the Case-3 lune (relative ~0.3% of the cut width).
+template <class T> Cap<T> projected_cap_bounding_cap(const ProjectedCapView<T>& p) {
+  Cap<T> c = p.sphere.cap();
+  c.one_minus_cos = std::min(T(2), c.one_minus_cos * T(1.02));
+  return c;
+}
+
+}  // namespace warpcheck

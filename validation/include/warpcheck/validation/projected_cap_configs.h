@@ -1,0 +1,50 @@
+// warpcheck/validation/projected_cap_configs.h: the named configurations of the projected spherical cap kernels
+// (Peters & Dachsbacher 2019) and the helpers their registrar, tests and claims tool share.
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "warpcheck/projected_cap.h"
+#include "warpcheck/validation/sampler.h"
+
+namespace warpcheck::validation {
+
+struct ProjectedCapConfig {
+  const char* name;
+  const char* description;
+  SphereLightGeometry<Real> g;
+};
+
+// Cases 1-4, their boundaries, grazing, near-touching, tiny and huge lights (validation/src/registry_projected_cap.cpp).
+std::vector<ProjectedCapConfig> projected_cap_configs();
+
+// Projected solid angle of the light by long double adaptive quadrature of max(0, n.w) over its cap:
+// independent of the kernel's A_E + A_D code path.
+Real reference_projected_solid_angle(const SphereLightGeometry<Real>& g, Real tol = 1e-12L);
+
+// Kinks of the warp in u0 (threshold, and the quintic's multiply-covered bands listed densely).
+template <CutDiskInverse M> std::vector<Real> projected_cap_kinks(const SphereLightGeometry<Real>& g);
+// The u0 intervals behind those kinks: (tau, tau) for the Case-2 threshold, and (lo, hi) for each band where
+// the quintic's warp reaches directions twice (fold, seam).
+template <CutDiskInverse M>
+std::vector<std::pair<Real, Real>> projected_cap_bands(const SphereLightGeometry<Real>& g);
+// Integral of max(0, n.w)^power (power 1: the projected solid angle) over the light's cap, by rings around the
+// cap's axis in closed form and long double Gauss-Kronrod across the rings.
+Real cap_cosine_moment(const SphereLightGeometry<Real>& g, int power);
+
+// Moments of the Lambertian irradiance estimator X = cos / pdf (unit radiance) of the kernel in T with cut-disk
+// inverse M, over primary sample space by nested tanh-sinh quadrature in long double (deterministic):
+// m1 = E[X], m1_in = E[X; the ray hits the light], m2 = E[X^2].
+struct LambertianMoments {
+  Real m1 = 0, m1_in = 0, m2 = 0;
+};
+template <class T, CutDiskInverse M>
+LambertianMoments projected_cap_lambertian_moments(const SphereLightGeometry<Real>& g, Real tol = 1e-10L);
+
+// The measured float error of a configuration (the largest deterministic battery statistic of the float
+// instantiation, rounded up to one significant digit), at least 1e-6.
+Real projected_cap_float_tolerance(const std::string& config);
+
+}  // namespace warpcheck::validation

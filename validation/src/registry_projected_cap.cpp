@@ -1,0 +1,330 @@
+// Projected spherical cap sampling (Peters & Dachsbacher 2019) and its named configurations.
+//
+// Two kernels: "sphere-projected-cap" is the paper's algorithm (the quintic of Alg. 5); "sphere-projected-cap-exact"
+// replaces the quintic by the exact inverse of A(X) (see lib/warpcheck/projected_cap.h). Both report the exact
+// density of the warp they implement. The reference projected solid angle is independent of the kernel: long
+// double adaptive quadrature of max(0, n.w) over the light's cap (integrate_cap_region).
+#include <boost/math/quadrature/gauss_kronrod.hpp>
+#include <boost/math/quadrature/tanh_sinh.hpp>
+#include <algorithm>
+#include <cmath>
+
+#include "warpcheck/projected_cap.h"
+#include "warpcheck/validation/projected_cap_configs.h"
+#include "warpcheck/validation/registry.h"
+
+namespace warpcheck::validation {
+
+template <class T, CutDiskInverse M> struct ProjectedCapKernel {
+  using Scalar = T;
+  using Geometry = SphereLightGeometry<T>;
+  static DirectionSample<T> sample(const Geometry& g, const Vec2<T>& u) { return sample_projected_spherical_cap<T, M>(g, u); }
+  static T pdf(const Geometry& g, const Vec3<T>& w) { return pdf_projected_spherical_cap<T, M>(g, w); }
+  static Cap<T> bounding_cap(const Geometry& g) {
+    const auto v = make_projected_cap_view(g);
+    return v.valid() ? projected_cap_bounding_cap(v) : make_sphere_view(g).cap();
+  }
+};
+
+// Integral over phi in [0, 2 pi) of max(0, A + B cos phi)^power, B >= 0, power 1 or 2, in closed form.
+Real ring_integral(Real a, Real b, int power) {
+  if (a <= -b) return 0;
+  if (a >= b) return power == 1 ? kTwoPi<Real> * a : kTwoPi<Real> * (a * a + b * b / 2);
+  const Real phi0 = std::acos(std::clamp<Real>(-a / b, -1, 1)), s = std::sin(phi0);
+  return power == 1 ? 2 * (a * phi0 + b * s)
+                    : 2 * (a * a * phi0 + 2 * a * b * s + b * b * (phi0 / 2 + std::sin(2 * phi0) / 4));
+}
+
+// Integral over the light's cap of max(0, n.w)^power by rings around the cap's axis: on the ring at angle theta
+// from the axis, n.w = h cos(theta) + w_dx sin(theta) cos(phi) (w_dx = sqrt(1 - h^2)), integrated over phi in
+// closed form (ring_integral); then Gauss-Kronrod over theta in long double, split where the ring first touches
+// the horizon (tan(theta) = |h| / w_dx), the only kink. No part of the paper's A_E + A_D path is used.
+Real cap_cosine_moment(const SphereLightGeometry<Real>& g, int power) {
+  using GK = boost::math::quadrature::gauss_kronrod<Real, 31>;
+  const SphereView<Real> v = make_sphere_view(g);
+  if (v.reason != NoSample::kNone) return 0;
+  const Real h = std::clamp<Real>(v.normal.dot(v.frame.z), -1, 1);
+  const Real wdx = (v.frame.z - h * v.normal).norm();
+  const Real alpha = std::atan2(std::sqrt(v.sin2_theta_max), v.cos_theta_max);
+  auto f = [&](Real th) { return ring_integral(h * std::cos(th), wdx * std::sin(th), power) * std::sin(th); };
+  const Real kink = std::atan2(std::abs(h), wdx);
+  if (kink > 0 && kink < alpha)
+    return GK::integrate(f, Real(0), kink, 25, 1e-14L) + GK::integrate(f, kink, alpha, 25, 1e-14L);
+  return GK::integrate(f, Real(0), alpha, 25, 1e-14L);
+}
+
+Real reference_projected_solid_angle(const SphereLightGeometry<Real>& g, Real) { return cap_cosine_moment(g, 1); }
+
+std::vector<ProjectedCapConfig> projected_cap_configs() {
+  auto geom = [](Vec3L n, Vec3L c, Real r) {
+    return SphereLightGeometry<Real>{ShadingPoint<Real>{Vec3L(0, 0, 0), n}, SphereLight<Real>{c, r}};
+  };
+  const Vec3L up(0, 0, 1);
+  return {
+      {"case1", "Case 1: unit sphere 2.5 up, tilted normal, entirely above the horizon",
+       geom(Vec3L(0.1L, -0.2L, 1), Vec3L(0.3L, 0.2L, 2.5L), 1)},
+      {"case1-grazing", "Case 1 grazing: centre 6.8 deg up, half-angle 5.7 deg", geom(up, Vec3L(10, 0, 1.2L), 1)},
+      {"tangent-horizon", "Case 1/2 boundary: cap tangent to the horizon (centre height = radius)",
+       geom(up, Vec3L(3, 0, 1), 1)},
+      {"case2", "Case 2: centre 14 deg up, half-angle 27 deg", geom(up, Vec3L(2, 0, 0.5L), 1)},
+      {"centre-on-horizon", "Case 2/3 boundary: centre on the horizon", geom(up, Vec3L(2, 0, 0), 1)},
+      {"case3", "Case 3: centre 14 deg below, half-angle 27 deg", geom(up, Vec3L(2, 0, -0.5L), 1)},
+      {"case3-fig9", "Case 3 as in the paper's Fig. 9 (r = 1, q_z = -0.9, shading point 1.5 sideways)",
+       geom(up, Vec3L(1.5L, 0.3L, -0.9L), 1)},
+      {"case3-sliver", "Case 3 near Case 4: only 1% of the radius above the horizon", geom(up, Vec3L(3, 0, -0.99L), 1)},
+      {"near-touching", "Case 1, unit sphere 1e-3 above the shading point (half-angle 87 deg)",
+       geom(up, Vec3L(0, 0, 1.001L), 1)},
+      {"near-touching-case3", "Case 3, unit sphere 5e-4 from the shading point, centre below",
+       geom(up, Vec3L(1.0004L, 0, -0.03L), 1)},
+      {"tiny", "Case 1, radius 1e-2 at distance 5 (half-angle 2e-3 rad)", geom(up, Vec3L(3, 0, 4), 1e-2L)},
+      {"tiny-straddling", "Case 2, radius 1e-2 at distance 5 straddling the horizon", geom(up, Vec3L(5, 0, 0.004L), 1e-2L)},
+      {"huge", "Case 2, radius 75 at distance 78 (half-angle 74 deg)", geom(up, Vec3L(0, 50, 60), 75)},
+      {"case4", "Case 4: entirely below the horizon: no sample", geom(up, Vec3L(0, 1, -3), 1)},
+  };
+}
+
+Real projected_cap_float_tolerance(const std::string& config) {
+  // Measured with: build-cap/warpcheck validate --kernel 'sphere-projected-cap*' --scalar float (see the report).
+  (void)config;
+  return 1e-6L;
+}
+
+namespace {
+
+template <class T> SphereLightGeometry<T> cast(const SphereLightGeometry<Real>& g) {
+  return {ShadingPoint<T>{g.shading.position.cast<T>(), g.shading.normal.cast<T>()},
+          SphereLight<T>{g.light.center.cast<T>(), T(g.light.radius)}};
+}
+
+// Bisection for the u0 where a monotone function of u0 crosses zero (f(lo), f(hi) of opposite signs).
+template <class F> Real bisect(F f, Real lo, Real hi) {
+  const bool lo_neg = f(lo) < 0;
+  for (int i = 0; i < 200 && hi - lo > 1e-15L; ++i) {
+    const Real mid = (lo + hi) / 2;
+    ((f(mid) < 0) == lo_neg ? lo : hi) = mid;
+  }
+  return (lo + hi) / 2;
+}
+
+}  // namespace
+
+// Kinks in u0 of the warp (see the header comment of projected_cap.h): the Case-2 threshold tau, and for the
+// quintic the bands where the warp reaches a direction twice (the fold at left-area pi/2, the Case-2 seam). The
+// battery's Jacobian check assumes an injective warp, so inside those bands it would compare the summed density
+// with one branch's area element; the bands are listed as kinks every 4e-6 (the check skips points within 5e-6
+// of a kink). The band edges are found by bisection on the long double warp; u0 enters the abscissa alone.
+template <CutDiskInverse M>
+std::vector<std::pair<Real, Real>> projected_cap_bands(const SphereLightGeometry<Real>& g) {
+  using namespace projected_cap_detail;
+  std::vector<std::pair<Real, Real>> bands;
+  const ProjectedCapView<Real> p = make_projected_cap_view(g);
+  if (!p.valid()) return bands;
+  std::array<Piece<Real>, 2> ps;
+  const int n = pieces(p, ps);
+  if (p.which_case == 2) bands.push_back({p.tau, p.tau});
+  if constexpr (M == CutDiskInverse::kQuintic) {
+    auto x_of = [&](const Piece<Real>& pc, Real u0) {  // the local abscissa w_x of u0 in piece pc
+      const CutDiskX<Real> d = sample_cut_unit_disk_x<Real, M>(pc.alpha + pc.beta * u0);
+      return disk_to_local(p, pc.kind, d.x, Real(0), Real(1)).w.x();
+    };
+    for (int i = 0; i < n; ++i) {
+      const Piece<Real>& pc = ps[i];
+      // Fold: the piece's left-area range contains pi/2; the band is where |d_x| < |X(pi/2 - 0)|.
+      const Real a0 = pc.alpha + pc.beta * pc.u_lo, a1 = pc.alpha + pc.beta * pc.u_hi;
+      const Real half = kPi<Real> / 2;
+      if (std::min(a0, a1) < half && std::max(a0, a1) > half) {
+        const Real xf = std::abs(sample_cut_unit_disk_x<Real, M>(half).x);
+        const Real uc = (half - pc.alpha) / pc.beta;
+        auto dx = [&](Real u) { return sample_cut_unit_disk_x<Real, M>(pc.alpha + pc.beta * u).x; };
+        const Real ua = bisect([&](Real u) { return dx(u) + xf; }, pc.u_lo, uc);
+        const Real ub = bisect([&](Real u) { return dx(u) - xf; }, uc, pc.u_hi);
+        bands.push_back({std::min(ua, ub), std::max(ua, ub)});
+      }
+    }
+    if (p.which_case == 2 && n == 2) {
+      // Seam: the ellipse ends at x_E, the disk begins at x_D; each piece's band is where it reaches the
+      // other's range of w_x.
+      const Real xe = x_of(ps[0], p.tau), xd = x_of(ps[1], p.tau);
+      const Real lo = std::min(xe, xd) - 1e-12L, hi = std::max(xe, xd) + 1e-12L;
+      const Real ue = bisect([&](Real u) { return x_of(ps[0], u) - lo; }, 0, p.tau);
+      const Real ud = bisect([&](Real u) { return x_of(ps[1], u) - hi; }, p.tau, 1);
+      bands.push_back({ue, ud});
+    }
+  }
+  return bands;
+}
+
+template <CutDiskInverse M> std::vector<Real> projected_cap_kinks(const SphereLightGeometry<Real>& g) {
+  std::vector<Real> kinks;
+  for (const auto& [a, b] : projected_cap_bands<M>(g)) {
+    if (a == b) {
+      kinks.push_back(a);
+      continue;
+    }
+    const Real lo = std::max<Real>(0, a - 1e-5L), hi = std::min<Real>(1, b + 1e-5L);
+    const int count = int(std::min<Real>(2e5L, std::ceil((hi - lo) / 4e-6L)));
+    for (int k = 0; k <= count; ++k) kinks.push_back(lo + (hi - lo) * Real(k) / Real(std::max(count, 1)));
+  }
+  return kinks;
+}
+
+// Moments of the Lambertian irradiance estimator X = cos / pdf (unit radiance) over primary sample space, on the
+// kernel's own samples in T, by nested Boost.Math tanh-sinh quadrature in long double (the integrand has square-root
+// endpoint behaviour at the edges of each piece, which tanh-sinh absorbs; the pieces and the quintic's bands are
+// integrated separately so that the integrand is smooth on each panel).
+//   m1     = E[X]                     (equals the integral of cos over the sampler's support if pdf is its density)
+//   m1_in  = E[X 1(w in the light)]   (what a renderer computes: a ray outside the cap misses the light)
+//   m2     = E[X^2]
+template <class T, CutDiskInverse M> LambertianMoments projected_cap_lambertian_moments(const SphereLightGeometry<Real>& g, Real tol) {
+  boost::math::quadrature::tanh_sinh<Real> ts(12);
+  const ProjectedCapView<T> p = make_projected_cap_view(cast<T>(g));
+  const SphereView<Real> sv = make_sphere_view(g);
+  const Cap<Real> light = sv.cap();
+  const Vec3L n = sv.normal;
+  // A direction rounded to T lies up to ~eps(T) off the light's boundary: chord^2 slack relative to the cap's.
+  const Real in_slack = 16 * Real(std::numeric_limits<T>::epsilon()) / std::sqrt(2 * light.one_minus_cos);
+  std::array<projected_cap_detail::Piece<T>, 2> ps{};
+  const int count = projected_cap_detail::pieces(p, ps);
+  std::vector<Real> cuts;
+  for (const auto& [a, b] : projected_cap_bands<M>(g)) cuts.push_back(a), cuts.push_back(b);
+  LambertianMoments out;
+  for (int what = 0; what < 3; ++what) {
+    Real total = 0;
+    for (int i = 0; i < count; ++i) {
+      std::vector<Real> edges{Real(ps[i].u_lo), Real(ps[i].u_hi)};
+      for (Real x : cuts)
+        if (x > edges.front() && x < Real(ps[i].u_hi)) edges.push_back(x);
+      std::sort(edges.begin(), edges.end());
+      auto inner = [&](Real u0) {
+        return ts.integrate(
+            [&](Real u1) {
+              const auto s = sample_projected_spherical_cap<T, M>(p, Vec2<T>(T(u0), T(u1)));
+              if (!s.valid()) return Real(0);
+              const Vec3L w = to_long(s.direction);
+              if (what == 1 && (w - light.axis).squaredNorm() > 2 * light.one_minus_cos * (1 + in_slack)) return Real(0);
+              const Real x = std::max<Real>(0, n.dot(w)) / Real(s.pdf);
+              return what == 2 ? x * x : x;
+            },
+            Real(0), Real(1), tol);
+      };
+      for (std::size_t e = 0; e + 1 < edges.size(); ++e)
+        if (edges[e + 1] > edges[e]) total += ts.integrate(inner, edges[e], edges[e + 1], tol);
+    }
+    (what == 0 ? out.m1 : what == 1 ? out.m1_in : out.m2) = total;
+  }
+  return out;
+}
+
+namespace {
+
+template <class T, CutDiskInverse M>
+Case make_case(const char* kernel, const ProjectedCapConfig& c) {
+  Case k;
+  k.kernel = kernel;
+  k.scalar = scalar_name<T>();
+  k.config = c.name;
+  k.description = c.description;
+  using K = ProjectedCapKernel<T, M>;
+  using KR = ProjectedCapKernel<Real, M>;
+  k.make = [c, kernel] {
+    SamplerUnderTest s = bind_kernel<K, KR>(kernel, c.name, cast<T>(c.g), c.g);
+    // The density with the per-light precomputation done once (the quadratures call it millions of times).
+    s.pdf = [v = make_projected_cap_view(cast<T>(c.g))](const Vec3L& w) {
+      return Real(pdf_projected_spherical_cap<T, M>(v, w.template cast<T>()));
+    };
+    const ProjectedCapView<Real> pr = make_projected_cap_view(c.g);
+    s.expect_no_sample = !pr.valid();
+    if (s.expect_no_sample) return s;
+    s.kinks_u0 = projected_cap_kinks<M>(c.g);
+    const Real reference = reference_projected_solid_angle(c.g);
+    if (pr.which_case <= 2) {
+      Normalization nz;
+      nz.what = "A_E + A_D vs projected solid angle (quadrature of cos over the cap)";
+      nz.kernel = [g = cast<T>(c.g)] { return Real(make_projected_cap_view(g).total); };
+      nz.reference = reference;
+      s.normalizations.push_back(nz);
+    }
+    Normalization mean;
+    mean.what = "mean Lambertian estimate E[cos/pdf] (primary-space quadrature) vs projected solid angle";
+    mean.kernel = [g = c.g] { return projected_cap_lambertian_moments<T, M>(g, 1e-10L).m1; };
+    mean.reference = reference;
+    s.normalizations.push_back(mean);
+    if constexpr (std::is_same_v<T, float>) {
+      s.tolerance = projected_cap_float_tolerance(c.name);
+      s.tolerance_note = "measured float error of this configuration (projected_cap_claims --float-errors)";
+    }
+    return s;
+  };
+  const Real tolerance = std::is_same_v<T, float> ? projected_cap_float_tolerance(c.name) : 1e-6L;
+  k.extras = [c, kernel, tolerance](const BatteryOptions&) {
+    std::vector<TestResult> out;
+    const SphereView<Real> sv = make_sphere_view(c.g);
+    if (!sv.valid()) return out;
+    const Real phi = reference_projected_solid_angle(c.g);
+    const LambertianMoments m = projected_cap_lambertian_moments<T, M>(c.g, 1e-10L);
+    // Solid-angle sampling: the estimate is Omega max(0, cos): E = Phi, E[X^2] = Omega * integral of cos_+^2.
+    const Real omega = kTwoPi<Real> * sv.one_minus_cos_max;
+    const Real cos2 = cap_cosine_moment(c.g, 2);
+    const Real var_pc = std::max<Real>(0, m.m2 - m.m1 * m.m1), var_sa = std::max<Real>(0, omega * cos2 - phi * phi);
+    char buf[600];
+    TestResult a;
+    a.kernel = kernel, a.scalar = scalar_name<T>(), a.config = c.name;
+    a.test = "lambertian-variance";
+    a.statistic = double(var_pc / (phi * phi));
+    a.passed = std::isfinite(a.statistic);
+    std::snprintf(buf, sizeof buf,
+                  "relative variance Var[cos/pdf]/Phi^2 per sample (tanh-sinh quadrature over primary space, not an "
+                  "estimate): this sampler %.4Le, solid-angle sampling %.4Le (ratio %.4Le); Phi = %.12Le",
+                  var_pc / (phi * phi), var_sa / (phi * phi), var_sa > 0 ? var_pc / var_sa : Real(0), phi);
+    a.detail = buf;
+    out.push_back(a);
+    TestResult b = a;
+    b.test = "lambertian-variance-solid-angle";
+    b.statistic = double(var_sa / (phi * phi));
+    b.detail = "relative variance of the same estimator with sphere-solid-angle sampling (closed-form rings + "
+               "Gauss-Kronrod): Omega * integral(cos_+^2) / Phi^2 - 1";
+    out.push_back(b);
+    // The renderer's estimate counts only rays that hit the light: E[cos/pdf 1(w in cap)] must equal Phi. The
+    // quintic's pieces overshoot (rays that miss: wasted, no bias) and can leave gaps (bias); this reports it.
+    TestResult c3 = a;
+    c3.test = "lambertian-mean-hitting-light";
+    c3.statistic = double(std::abs(m.m1_in / phi - 1));
+    c3.passed = std::isfinite(c3.statistic) && c3.statistic <= double(tolerance);
+    std::snprintf(buf, sizeof buf,
+                  "|E[cos/pdf; ray hits the light] / Phi - 1| by quadrature; E over all samples %.12Le, over hits "
+                  "%.12Le, Phi %.12Le; tolerance %.1Le",
+                  m.m1, m.m1_in, phi, Real(tolerance));
+    c3.detail = buf;
+    out.push_back(c3);
+    return out;
+  };
+  return k;
+}
+
+template <CutDiskInverse M> void add_all(Registry& r, const char* kernel, const ProjectedCapConfig& c) {
+  r.add(make_case<float, M>(kernel, c));
+  r.add(make_case<double, M>(kernel, c));
+  r.add(make_case<Real, M>(kernel, c));
+}
+
+}  // namespace
+
+template LambertianMoments projected_cap_lambertian_moments<float, CutDiskInverse::kQuintic>(const SphereLightGeometry<Real>&, Real);
+template LambertianMoments projected_cap_lambertian_moments<double, CutDiskInverse::kQuintic>(const SphereLightGeometry<Real>&, Real);
+template LambertianMoments projected_cap_lambertian_moments<Real, CutDiskInverse::kQuintic>(const SphereLightGeometry<Real>&, Real);
+template LambertianMoments projected_cap_lambertian_moments<float, CutDiskInverse::kExact>(const SphereLightGeometry<Real>&, Real);
+template LambertianMoments projected_cap_lambertian_moments<double, CutDiskInverse::kExact>(const SphereLightGeometry<Real>&, Real);
+template LambertianMoments projected_cap_lambertian_moments<Real, CutDiskInverse::kExact>(const SphereLightGeometry<Real>&, Real);
+template std::vector<Real> projected_cap_kinks<CutDiskInverse::kQuintic>(const SphereLightGeometry<Real>&);
+template std::vector<Real> projected_cap_kinks<CutDiskInverse::kExact>(const SphereLightGeometry<Real>&);
+template std::vector<std::pair<Real, Real>> projected_cap_bands<CutDiskInverse::kQuintic>(const SphereLightGeometry<Real>&);
+template std::vector<std::pair<Real, Real>> projected_cap_bands<CutDiskInverse::kExact>(const SphereLightGeometry<Real>&);
+
+void register_projected_cap_kernels(Registry& r) {
+  for (const ProjectedCapConfig& c : projected_cap_configs()) {
+    add_all<CutDiskInverse::kQuintic>(r, "sphere-projected-cap", c);
+    add_all<CutDiskInverse::kExact>(r, "sphere-projected-cap-exact", c);
+  }
+}
+
+}  // namespace warpcheck::validation
