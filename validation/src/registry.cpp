@@ -40,6 +40,8 @@ Registry default_registry() {
   // One line per kernel family.
   register_sphere_kernels(r);
   register_polygon_kernels(r);
+  register_projected_cap_kernels(r);
+  register_sptd_kernels(r);
   return r;
 }
 

@@ -48,5 +48,7 @@ Registry default_registry();
 // Registrars, one per kernel family.
 void register_sphere_kernels(Registry& r);
 void register_polygon_kernels(Registry& r);
+void register_projected_cap_kernels(Registry& r);
+void register_sptd_kernels(Registry& r);
 
 }  // namespace warpcheck::validation

@@ -1,0 +1,454 @@
+// warpcheck/sptd.h: spherical pivot transformed distributions (SPTDs), Dupuy, Heitz & Belcour 2017,
+// "A Spherical Cap Preserving Parameterization for Spherical Distributions".
+//
+// Contents (equation numbers are the paper's):
+//   pivot_transform_point   Eq. 2, the pivot transformation of any point of R^3 (an involution, Eq. 3)
+//   pivot_transform         Eq. 2 restricted to the unit sphere, in the form g(w) = r_p + k (r_p - w) / |r_p - w|^2
+//   pivot_jacobian          Eq. 4, d g(w) / d w = (k / |w - r_p|^2)^2, k = 1 - |r_p|^2
+//   pivot_transform_cap     Eqs. 6-7, the image g(C) of a spherical cap
+//   sptd_density            Eq. 8, D(w) = D_std(g(w)) dg/dw for the uniform and the clamped-cosine D_std
+//   sptd_cap_integral       Eq. 10, the integral of D over a cap C = integral of D_std over g(C)
+//   cap_intersection_solid_angle        Eqs. 35-36 (Appendix B, exact), and Eq. 37 (the approximation)
+//   sptd_uniform_two_cap_integral       Eqs. 17-19, a uniform SPTD over the intersection of two caps
+//   sample_sptd_cap / pdf_sptd_cap      Sec. 4.2: sample D_std over g(C), pivot back (Fig. 5)
+//   pivot_phase_function    Eq. 25; henyey_greenstein Eq. 26; hg_to_pivot Eqs. 27-28
+//   sample_pivot_phase_sphere_light     Sec. 6.2, joint pivot-phase-function and sphere-light sampling
+//
+// Derivations that the paper leaves out (its supplement is not available to us):
+//  * On the sphere, Eq. 2 equals the "anti-inversion" g(w) = r_p + k (r_p - w) / |r_p - w|^2 (the second
+//    intersection of the line from w through r_p with the sphere: |g(w) - r_p| |w - r_p| = k is Eq. 33, and
+//    g(w) - r_p points away from w - r_p). test_sptd checks the two forms agree. We use the second form on
+//    the sphere: it has no cancellation in its denominator, and it is exactly what the Jacobian (Eq. 4) refers to.
+//  * Eq. 6 takes the normalised mean of the two transformed boundary points as the axis of g(C). That is
+//    right only when g(C) is at most a hemisphere; for a larger image cap the mean points to the centre of the
+//    complement, and for a hemisphere it is zero. We take the axis as +-the in-plane bisector of g(w_1),
+//    g(w_2) and pick the sign for which g(w_c) (which lies in g(C), as w_c lies in C) is inside.
+//  * The clamped-cosine D_std = max(0, w.n) / pi over a cap: its integral is the projected solid angle of
+//    the cap above the horizon of n (Snyder 1996 gives it for caps up to a hemisphere). We derive it and the
+//    sampler from the orthographic projection onto the disk of n (Malley's method, so cosine-weighted =
+//    uniform in the projection): with n = z and the cap axis a = (sin t, 0, cos t), half-angle alpha, the
+//    cap's boundary circle projects to the ellipse E centred at x_c = sin t cos(alpha) with semi-axes
+//    A = sin(alpha) |cos t| (along x) and sin(alpha) (along y); points with x >= x_0 = cos(alpha) / sin(t)
+//    lie on the cap's side of its plane everywhere in the upper hemisphere. The projected region R is
+//      cos t >= 0:  (E with x < x_0)  union  (disk with x >= x_0)          (convex)
+//      cos t < 0:   (disk with x >= x_0) minus E                         (a crescent)
+//    which holds for any alpha in (0, pi]. R's area (the projected solid angle) is a sum of elliptic and
+//    circular segment areas, in closed form. Sampling: when R = E (cap entirely above the horizon) an affine
+//    image of the uniform disk, in closed form; otherwise x by inverting the closed-form area-CDF with
+//    Boost's TOMS 748 root finder, then y uniform on R's chord at x. (The projected spherical cap sampler of
+//    Peters & Dachsbacher 2019 would serve here too; lib/warpcheck/projected_cap.h did not exist when this
+//    was written, so this is our own exact method; its cost is one 1D root find per sample near the horizon.)
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+#include <boost/math/tools/roots.hpp>
+
+#include "warpcheck/core.h"
+#include "warpcheck/sphere.h"
+
+namespace warpcheck {
+
+// ---- The pivot transformation (Sec. 3.2) -------------------------------------------------------------------
+
+// A pivot r_p must lie strictly inside the unit sphere.
+template <class T> bool valid_pivot(const Vec3<T>& rp) {
+  return all_finite(rp) && rp.squaredNorm() < T(1);
+}
+
+// k = 1 - |r_p|^2 as (1 - |r_p|)(1 + |r_p|).
+template <class T> T pivot_k(const Vec3<T>& rp) {
+  const T r = rp.norm();
+  return (T(1) - r) * (T(1) + r);
+}
+
+// Eq. 2, verbatim, for any point r of R^3 (not only the sphere). Eq. 3: g(g(r)) = r.
+template <class T> Vec3<T> pivot_transform_point(const Vec3<T>& r, const Vec3<T>& rp) {
+  const T a = r.dot(rp) - T(1);
+  const Vec3<T> d = r - rp;
+  const Vec3<T> c = r.cross(rp);
+  return (a * d - d.cross(c)) / (a * a + c.squaredNorm());
+}
+
+// Eq. 2 on the unit sphere, in the anti-inversion form derived in the header comment; renormalised.
+template <class T> Vec3<T> pivot_transform(const Vec3<T>& w, const Vec3<T>& rp, T k) {
+  const Vec3<T> d = rp - w;
+  const T d2 = d.squaredNorm();
+  if (!(d2 > T(0))) return w;  // w on the pivot: impossible for |r_p| < 1 and unit w
+  const Vec3<T> g = rp + (k / d2) * d;
+  return g / g.norm();
+}
+template <class T> Vec3<T> pivot_transform(const Vec3<T>& w, const Vec3<T>& rp) {
+  return pivot_transform(w, rp, pivot_k(rp));
+}
+
+// Eq. 4: the Jacobian dg(w)/dw = (k / |w - r_p|^2)^2 of the transformation on the sphere.
+template <class T> T pivot_jacobian(const Vec3<T>& w, const Vec3<T>& rp, T k) {
+  const T j = k / (w - rp).squaredNorm();
+  return j * j;
+}
+template <class T> T pivot_jacobian(const Vec3<T>& w, const Vec3<T>& rp) { return pivot_jacobian(w, rp, pivot_k(rp)); }
+
+// Eqs. 6-7 (with the orientation fix described in the header): the cap g(C).
+template <class T> Cap<T> pivot_transform_cap(const Cap<T>& c, const Vec3<T>& rp, T k) {
+  if (c.one_minus_cos >= T(2)) return Cap<T>{c.axis, T(2)};  // the whole sphere maps onto itself
+  const Vec3<T>& wc = c.axis;
+  // The plane through the origin, w_c and r_p (Fig. 3 (1)); any plane through w_c when r_p is parallel to it.
+  Vec3<T> t = rp - rp.dot(wc) * wc;
+  const T tn = t.norm();
+  t = tn > T(64) * std::numeric_limits<T>::epsilon() * rp.norm() && tn > T(0) ? Vec3<T>(t / tn)
+                                                                               : Frame<T>::from_z(wc).x;
+  const T omc = c.one_minus_cos;
+  const T cos_a = T(1) - omc, sin_a = std::sqrt(std::max(T(0), omc * (T(2) - omc)));
+  // Fig. 3 (2)-(3): the boundary points in that plane and their images.
+  const Vec3<T> g1 = pivot_transform(Vec3<T>(cos_a * wc + sin_a * t), rp, k);
+  const Vec3<T> g2 = pivot_transform(Vec3<T>(cos_a * wc - sin_a * t), rp, k);
+  const Vec3<T> gc = pivot_transform(wc, rp, k);
+  // Eq. 6 (in-plane bisector), robust for image caps of any size.
+  const Vec3<T> sum = g1 + g2, diff = g1 - g2;
+  Vec3<T> axis;
+  if (sum.squaredNorm() >= diff.squaredNorm()) axis = sum / sum.norm();
+  else {
+    const Vec3<T> m = wc.cross(t).cross(diff);  // in the plane, orthogonal to g1 - g2
+    axis = m / m.norm();
+  }
+  if ((gc - axis).squaredNorm() > (g1 - axis).squaredNorm()) axis = -axis;  // g(w_c) lies inside g(C)
+  // Eq. 7, as a chord length (1 - cos = |g_i - axis|^2 / 2) averaged over both boundary points.
+  const T image_omc = std::min(T(2), ((g1 - axis).squaredNorm() + (g2 - axis).squaredNorm()) / T(4));
+  return Cap<T>{axis, image_omc};
+}
+template <class T> Cap<T> pivot_transform_cap(const Cap<T>& c, const Vec3<T>& rp) {
+  return pivot_transform_cap(c, rp, pivot_k(rp));
+}
+
+// ---- The original distributions D_std and their cap integrals ------------------------------------------------
+
+enum class SptdBase : std::uint8_t { kUniform, kClampedCosine };
+
+template <class T> struct Sptd {
+  Vec3<T> pivot = Vec3<T>::Zero();
+  SptdBase base = SptdBase::kUniform;
+  Vec3<T> base_axis = Vec3<T>(T(0), T(0), T(1));  // n of the clamped cosine max(0, w.n) / pi
+};
+
+template <class T> T sptd_base_density(const Sptd<T>& d, const Vec3<T>& w) {
+  if (d.base == SptdBase::kUniform) return T(1) / (T(4) * kPi<T>);
+  return std::max(T(0), w.dot(d.base_axis)) / kPi<T>;
+}
+
+// Eq. 8: D(w) = D_std(g(w)) (k / |w - r_p|^2)^2.
+template <class T> T sptd_density(const Sptd<T>& d, const Vec3<T>& w) {
+  const T k = pivot_k(d.pivot);
+  return sptd_base_density(d, pivot_transform(w, d.pivot, k)) * pivot_jacobian(w, d.pivot, k);
+}
+
+// The clamped cosine restricted to a cap, in the projected-disk form derived in the header.
+template <class T> struct CosineCapView {
+  NoSample reason = NoSample::kNone;
+  Cap<T> cap;
+  Vec3<T> ex = Vec3<T>::Zero(), ey = Vec3<T>::Zero(), ez = Vec3<T>::Zero();  // ez = n; ex towards the cap axis
+  T cos_a = 0, sin_a = 0;      // cap half-angle alpha
+  T cos_t = 0, sin_t = 0;      // angle t between the cap axis and n
+  T xc = 0, A = 0, x0 = 0;     // ellipse centre and x semi-axis; x >= x0: full chord side
+  bool ellipse_only = false;   // R = E (cap entirely above the horizon)
+  T area = 0;                  // projected solid angle of (cap, upper hemisphere) = area of R
+
+  bool valid() const { return reason == NoSample::kNone; }
+
+  // Area of the ellipse E with abscissa < x, and of the unit disk with abscissa < x.
+  T ellipse_cdf(T x) const {
+    if (!(A > T(0))) return T(0);
+    const T t = std::clamp((x - xc) / A, T(-1), T(1));
+    return sin_a * A * (t * std::sqrt((T(1) - t) * (T(1) + t)) + std::asin(t) + kPi<T> / T(2));
+  }
+  static T disk_cdf(T x) {
+    x = std::clamp(x, T(-1), T(1));
+    return x * std::sqrt((T(1) - x) * (T(1) + x)) + std::asin(x) + kPi<T> / T(2);
+  }
+  // Area of R with abscissa < x.
+  T cdf(T x) const {
+    if (cos_t >= T(0)) return ellipse_cdf(std::min(x, x0)) + (x > x0 ? disk_cdf(x) - disk_cdf(x0) : T(0));
+    return x > x0 ? std::max(T(0), (disk_cdf(x) - disk_cdf(x0)) - (ellipse_cdf(x) - ellipse_cdf(x0))) : T(0);
+  }
+  // Half-height of E at abscissa x (0 outside it).
+  T ellipse_half_height(T x) const {
+    if (!(A > T(0))) return T(0);
+    const T t = std::clamp((x - xc) / A, T(-1), T(1));
+    return sin_a * std::sqrt((T(1) - t) * (T(1) + t));
+  }
+};
+
+template <class T> CosineCapView<T> make_cosine_cap_view(const Cap<T>& cap, const Vec3<T>& n) {
+  CosineCapView<T> v;
+  v.cap = cap;
+  if (!all_finite(cap.axis) || !all_finite(n) || !std::isfinite(cap.one_minus_cos))
+    return v.reason = NoSample::kNonFinite, v;
+  if (!(cap.one_minus_cos > T(0))) return v.reason = NoSample::kZeroSize, v;
+  const T omc = std::min(T(2), cap.one_minus_cos);
+  v.cos_a = T(1) - omc;
+  v.sin_a = std::sqrt(std::max(T(0), omc * (T(2) - omc)));
+  v.ez = n;
+  v.cos_t = std::clamp(cap.axis.dot(n), T(-1), T(1));
+  const Vec3<T> tangential = cap.axis - v.cos_t * n;
+  v.sin_t = cap.axis.cross(n).norm();
+  if (v.sin_t > T(0) && tangential.norm() > T(0)) v.ex = tangential / tangential.norm();
+  else v.ex = Frame<T>::from_z(n).x, v.sin_t = T(0);
+  v.ey = v.ez.cross(v.ex);
+  v.xc = v.sin_t * v.cos_a;
+  v.A = v.sin_a * std::abs(v.cos_t);
+  // x >= x0 <=> cos(alpha) - x sin(t) <= 0; clamped to +-2 (only comparisons with x in [-1, 1] matter).
+  if (v.sin_t > T(0)) v.x0 = std::clamp(v.cos_a / v.sin_t, T(-2), T(2));
+  else v.x0 = v.cos_a > T(0) ? T(2) : T(-2);
+  v.ellipse_only = v.cos_t >= T(0) && v.x0 >= v.xc + v.A;
+  v.area = v.ellipse_only ? kPi<T> * v.sin_a * v.A : v.cdf(T(1));
+  if (!(v.area > T(0)) || !std::isfinite(v.area)) return v.reason = NoSample::kBelowHorizon, v;
+  return v;
+}
+
+// Integral of D_std over a cap: the uniform one is omc / 2 (solid angle / 4 pi); the clamped cosine one
+// is the projected solid angle / pi.
+template <class T> T base_cap_integral(const Sptd<T>& d, const Cap<T>& c) {
+  if (d.base == SptdBase::kUniform) return std::min(T(2), c.one_minus_cos) / T(2);
+  const CosineCapView<T> v = make_cosine_cap_view(c, d.base_axis);
+  return v.valid() ? v.area / kPi<T> : T(0);
+}
+
+// Eq. 10: the integral of the SPTD over the cap C.
+template <class T> T sptd_cap_integral(const Sptd<T>& d, const Cap<T>& c) {
+  return base_cap_integral(d, pivot_transform_cap(c, d.pivot));
+}
+
+// ---- Intersection of two caps (Appendix B) ---------------------------------------------------------------------
+
+// Angles from chord lengths (accurate for tiny caps): psi = 2 asin(sqrt(omc / 2)).
+template <class T> T cap_half_angle(const Cap<T>& c) {
+  return T(2) * std::asin(std::sqrt(std::clamp(c.one_minus_cos / T(2), T(0), T(1))));
+}
+template <class T> T angle_between_unit(const Vec3<T>& a, const Vec3<T>& b) {
+  return T(2) * std::asin(std::min(T(1), (a - b).norm() / T(2)));
+}
+
+// Eqs. 35-36 (Oat & Sander 2007; Tovchigrechko & Vakser 2001). One case the paper's Eq. 35 omits: when the
+// two caps together cover the sphere (psi_1 + psi_2 + psi_d >= 2 pi) the intersection is A_1 + A_2 - 4 pi.
+template <class T> T cap_intersection_solid_angle(const Cap<T>& c1, const Cap<T>& c2) {
+  T p1 = cap_half_angle(c1), p2 = cap_half_angle(c2);
+  T a1 = c1.solid_angle(), a2 = c2.solid_angle();
+  if (p1 > p2) std::swap(p1, p2), std::swap(a1, a2);
+  const T pd = angle_between_unit(c1.axis, c2.axis);
+  if (p2 - p1 >= pd) return a1;                                    // the smaller cap inside the larger
+  if (p1 + p2 <= pd) return T(0);                                  // disjoint
+  if (p1 + p2 + pd >= kTwoPi<T>) return std::max(T(0), a1 + a2 - T(4) * kPi<T>);  // union covers the sphere
+  const T c1c = std::cos(p1), c2c = std::cos(p2), cd = std::cos(pd);
+  const T s1 = std::sin(p1), s2 = std::sin(p2), sd = std::sin(pd);
+  auto acos_c = [](T x) { return std::acos(std::clamp(x, T(-1), T(1))); };
+  const T b = kTwoPi<T> - kTwoPi<T> * c1c - kTwoPi<T> * c2c - T(2) * acos_c((cd - c1c * c2c) / (s1 * s2)) +
+              T(2) * c1c * acos_c((c1c * cd - c2c) / (s1 * sd)) + T(2) * c2c * acos_c((c2c * cd - c1c) / (s2 * sd));
+  return std::clamp(b, T(0), std::min(a1, a2));
+}
+
+// Eqs. 37-38: the approximation of Oat & Sander 2007 used by the paper's real-time implementation (only for
+// the "otherwise" case of Eq. 35; the other cases are exact as above).
+template <class T> T cap_intersection_solid_angle_approx(const Cap<T>& c1, const Cap<T>& c2) {
+  T p1 = cap_half_angle(c1), p2 = cap_half_angle(c2);
+  T a1 = c1.solid_angle();
+  if (p1 > p2) std::swap(p1, p2), a1 = c2.solid_angle();
+  const T pd = angle_between_unit(c1.axis, c2.axis);
+  if (p2 - p1 >= pd) return a1;
+  if (p1 + p2 <= pd) return T(0);
+  const T x = std::clamp((p1 + p2 - pd) / (T(2) * p1), T(0), T(1));
+  return a1 * (T(3) * x * x - T(2) * x * x * x);
+}
+
+// Eqs. 17-19: a uniform SPTD integrated over the intersection D = C n H of two caps is
+// (1 / 4 pi) |g(C) n g(H)|.
+template <class T> T sptd_uniform_two_cap_integral(const Vec3<T>& rp, const Cap<T>& c, const Cap<T>& h) {
+  const T k = pivot_k(rp);
+  return cap_intersection_solid_angle(pivot_transform_cap(c, rp, k), pivot_transform_cap(h, rp, k)) /
+         (T(4) * kPi<T>);
+}
+
+// ---- Sampling D_std over a cap -----------------------------------------------------------------------------
+
+// Uniform over a cap (Shirley 1996 cone sampling, as in sphere.h): 1 - cos = u0 (1 - cos(psi)).
+template <class T> Vec3<T> sample_uniform_cap_direction(const Cap<T>& c, const Vec2<T>& u) {
+  const T omc = u[0] * std::min(T(2), c.one_minus_cos);
+  const T sin_t = std::sqrt(std::max(T(0), omc * (T(2) - omc)));
+  const T phi = kTwoPi<T> * u[1];
+  const Vec3<T> w = Frame<T>::from_z(c.axis).to_world(Vec3<T>(sin_t * std::cos(phi), sin_t * std::sin(phi), T(1) - omc));
+  return w / w.norm();
+}
+
+// Clamped cosine over a cap: a point of R (header comment) lifted to the hemisphere of n.
+template <class T> Vec3<T> sample_cosine_cap_direction(const CosineCapView<T>& v, const Vec2<T>& u) {
+  T x, y;
+  if (v.ellipse_only) {
+    // Uniform in E: the uniform disk (polar map) under the affine map onto E.
+    const T r = std::sqrt(u[0]), phi = kTwoPi<T> * u[1];
+    x = v.xc + v.A * r * std::cos(phi);
+    y = v.sin_a * r * std::sin(phi);
+  } else {
+    // x from the area-CDF of R (TOMS 748 on a bracket: the CDF is monotone and continuous), then y uniform on
+    // R's chord at x. Hand-rolled inversion because the CDF is ours; the root finder is Boost's.
+    const T target = u[0] * v.area;
+    T lo = T(-1), hi = T(1);
+    if (v.cos_t >= T(0)) lo = std::max(lo, v.xc - v.A);
+    else lo = std::max(lo, std::min(v.x0, T(1)));
+    auto f = [&](T x) { return v.cdf(x) - target; };
+    T flo = f(lo), fhi = f(hi);
+    if (flo >= T(0)) x = lo;
+    else if (fhi <= T(0)) x = hi;
+    else {
+      std::uintmax_t iters = 200;
+      const auto tol = boost::math::tools::eps_tolerance<T>(std::numeric_limits<T>::digits - 2);
+      const auto r = boost::math::tools::toms748_solve(f, lo, hi, flo, fhi, tol, iters);
+      x = (r.first + r.second) / T(2);
+    }
+    const T c = std::sqrt(std::max(T(0), (T(1) - x) * (T(1) + x)));
+    const T m = std::min(c, v.ellipse_half_height(x));
+    const T s = T(2) * u[1] - T(1);  // in [-1, 1)
+    if (v.cos_t >= T(0)) y = s * (x < v.x0 ? m : c);
+    else y = std::copysign(m + (c - m) * std::abs(s), s);  // the crescent: jumps across E at u1 = 1/2
+  }
+  const T z = std::sqrt(std::max(T(0), (T(1) - x) * (T(1) + x) - y * y));
+  const Vec3<T> w = x * v.ex + y * v.ey + z * v.ez;
+  return w / w.norm();
+}
+
+// ---- SPTDs over a cap (Sec. 4.2, Fig. 5) -----------------------------------------------------------------------
+
+template <class T> struct SptdCapGeometry {
+  Sptd<T> sptd;
+  Cap<T> cap = Cap<T>{Vec3<T>(T(0), T(0), T(1)), T(2)};  // default: the whole sphere
+
+  template <class U> SptdCapGeometry<U> cast() const {
+    SptdCapGeometry<U> g;
+    g.sptd.pivot = sptd.pivot.template cast<U>();
+    g.sptd.base = sptd.base;
+    g.sptd.base_axis = sptd.base_axis.template cast<U>();
+    g.cap = Cap<U>{cap.axis.template cast<U>(), U(cap.one_minus_cos)};
+    return g;
+  }
+};
+
+template <class T> struct SptdCapView {
+  NoSample reason = NoSample::kNone;
+  Sptd<T> sptd;
+  T k = 0;
+  Cap<T> cap, image;        // C and g(C)
+  CosineCapView<T> cosine;  // for the clamped-cosine base
+  T base_integral = 0;      // integral of D_std over g(C) = integral of D over C (Eq. 10)
+  bool valid() const { return reason == NoSample::kNone; }
+};
+
+template <class T> SptdCapView<T> make_sptd_cap_view(const SptdCapGeometry<T>& g) {
+  SptdCapView<T> v;
+  v.sptd = g.sptd;
+  v.cap = g.cap;
+  if (!all_finite(g.sptd.pivot) || !all_finite(g.sptd.base_axis) || !all_finite(g.cap.axis) ||
+      !std::isfinite(g.cap.one_minus_cos))
+    return v.reason = NoSample::kNonFinite, v;
+  if (!valid_pivot(g.sptd.pivot)) return v.reason = NoSample::kInvalidGeometry, v;
+  if (g.cap.one_minus_cos < T(0)) return v.reason = NoSample::kNegativeSize, v;
+  if (!(g.cap.one_minus_cos > T(0))) return v.reason = NoSample::kZeroSize, v;
+  if (!normalize_normal(g.cap.axis, v.cap.axis)) return v.reason = NoSample::kInvalidGeometry, v;
+  if (g.sptd.base == SptdBase::kClampedCosine && !normalize_normal(g.sptd.base_axis, v.sptd.base_axis))
+    return v.reason = NoSample::kBadNormal, v;
+  v.k = pivot_k(v.sptd.pivot);
+  if (!(v.k > T(0))) return v.reason = NoSample::kInvalidGeometry, v;
+  v.image = pivot_transform_cap(v.cap, v.sptd.pivot, v.k);
+  if (!(v.image.one_minus_cos > T(0)) || !all_finite(v.image.axis)) return v.reason = NoSample::kTooSmall, v;
+  if (v.sptd.base == SptdBase::kUniform) {
+    v.base_integral = v.image.one_minus_cos / T(2);
+  } else {
+    v.cosine = make_cosine_cap_view(v.image, v.sptd.base_axis);
+    if (!v.cosine.valid()) return v.reason = v.cosine.reason, v;
+    v.base_integral = v.cosine.area / kPi<T>;
+  }
+  return v;
+}
+
+// Density of the original distribution restricted to g(C), normalised, at w_i.
+template <class T> T base_cap_pdf(const SptdCapView<T>& v, const Vec3<T>& wi) {
+  // Membership with a relative slack of 8 eps on the chord: a sample generated inside g(C) must test inside
+  // after the pivot round trip (two roundings).
+  const T slack = T(8) * std::numeric_limits<T>::epsilon();
+  if (!((wi - v.image.axis).squaredNorm() <= T(2) * v.image.one_minus_cos * (T(1) + slack))) return T(0);
+  if (v.sptd.base == SptdBase::kUniform) return T(1) / v.image.solid_angle();
+  const T c = wi.dot(v.sptd.base_axis);
+  return c > T(0) ? c / v.cosine.area : T(0);
+}
+
+template <class T> T pdf_sptd_cap(const SptdCapView<T>& v, const Vec3<T>& w) {
+  if (!v.valid() || !all_finite(w)) return T(0);
+  const T len = w.norm();
+  if (!(len > T(0))) return T(0);
+  const Vec3<T> wu = w / len;
+  const T p = base_cap_pdf(v, pivot_transform(wu, v.sptd.pivot, v.k));
+  return p > T(0) ? p * pivot_jacobian(wu, v.sptd.pivot, v.k) : T(0);
+}
+
+template <class T> DirectionSample<T> sample_sptd_cap(const SptdCapView<T>& v, const Vec2<T>& u) {
+  if (!v.valid()) return DirectionSample<T>::none(v.reason);
+  const Vec3<T> wi = v.sptd.base == SptdBase::kUniform ? sample_uniform_cap_direction(v.image, u)
+                                                       : sample_cosine_cap_direction(v.cosine, u);
+  DirectionSample<T> s;
+  s.direction = pivot_transform(wi, v.sptd.pivot, v.k);  // Fig. 5 (4): w = g(w_i)
+  s.pdf = pdf_sptd_cap(v, s.direction);
+  if (!(s.pdf > T(0)) || !std::isfinite(s.pdf) || !all_finite(s.direction))
+    return DirectionSample<T>::none(NoSample::kOnSilhouette);
+  return s;
+}
+
+template <class T> DirectionSample<T> sample_sptd_cap(const SptdCapGeometry<T>& g, const Vec2<T>& u) {
+  return sample_sptd_cap(make_sptd_cap_view(g), u);
+}
+template <class T> T pdf_sptd_cap(const SptdCapGeometry<T>& g, const Vec3<T>& w) {
+  return pdf_sptd_cap(make_sptd_cap_view(g), w);
+}
+
+// ---- Phase functions (Sec. 6.2) ----------------------------------------------------------------------------
+
+// Eq. 25: the uniform SPTD with pivot g_p w_o, as a function of mu = w_o . w.
+template <class T> T pivot_phase_function(T mu, T gp) {
+  const T r = (T(1) - gp * gp) / (T(1) + gp * gp - T(2) * gp * mu);
+  return r * r / (T(4) * kPi<T>);
+}
+// Eq. 26.
+template <class T> T henyey_greenstein(T mu, T g) {
+  const T d = T(1) + g * g - T(2) * g * mu;
+  return (T(1) - g * g) / (T(4) * kPi<T> * d * std::sqrt(d));
+}
+// Eqs. 27-28: the paper's rational fit g_p(g).
+template <class T> T hg_to_pivot(T g) {
+  const T u = std::abs(g);
+  const T q = (T(0.7489L) * u - T(0.6121L) * u * u) / (T(1) - T(0.8409L) * u + T(0.0223L) * u * u);
+  return std::copysign(q, g);
+}
+
+// The pivot phase function as an SPTD geometry: pivot g_p w_o, uniform base, over a cap (the whole sphere
+// by default).
+template <class T> SptdCapGeometry<T> pivot_phase_geometry(const Vec3<T>& wo, T gp, const Cap<T>& cap = Cap<T>{Vec3<T>(T(0), T(0), T(1)), T(2)}) {
+  SptdCapGeometry<T> g;
+  g.sptd.pivot = gp * wo;
+  g.sptd.base = SptdBase::kUniform;
+  g.cap = cap;
+  return g;
+}
+
+// Sec. 6.2, Fig. 17 (right): the pivot phase function sampled jointly with a sphere light, i.e. restricted
+// to the cone the light subtends. The density is normalised over that cone.
+template <class T> SptdCapGeometry<T> pivot_phase_sphere_light_geometry(const Vec3<T>& wo, T gp,
+                                                                       const SphereLightGeometry<T>& light) {
+  // A medium has no horizon: aim the shading normal at the light so that only the light's own validity counts.
+  SphereLightGeometry<T> g = light;
+  g.shading.normal = light.light.center - light.shading.position;
+  const SphereView<T> sv = make_sphere_view(g);
+  Cap<T> cap = sv.cap();
+  if (!sv.valid()) cap.one_minus_cos = T(0);  // gives "zero size": no sample
+  return pivot_phase_geometry(wo, gp, cap);
+}
+
+}  // namespace warpcheck
