@@ -202,9 +202,25 @@ template <class T> PolygonView<T> make_polygon_view(const PolygonLightGeometry<T
   centroid /= T(g.light.count);
   if (!all_finite(centroid)) return v.reason = NoSample::kNonFinite, v;
   v.plane_distance = v.plane_normal.dot(centroid);
-  if (!(v.plane_distance != T(0))) return v.reason = NoSample::kEdgeOn, v;
+  // Edge-on up to rounding: the offsets V_k - x and the normal carry a few eps of relative error, so
+  // plane_distance is known only to a few eps max_k |V_k - x|_inf. Below 8 times that, which side of the light
+  // x is on is not determined, and the kernels' samples and densities could pick different sides (found by
+  // fuzz_polygon_projected_double / fuzz_polygon_solid_angle_double with x on the light, issue 7).
+  T reach = 0;
+  for (int i = 0; i < g.light.count; ++i)
+    reach = std::max(reach, Vec3<T>(g.light.vertices[i] - g.shading.position).cwiseAbs().maxCoeff());
+  if (!(std::abs(v.plane_distance) > T(8) * std::numeric_limits<T>::epsilon() * reach))
+    return v.reason = NoSample::kEdgeOn, v;
   v.local.count = g.light.count;
-  for (int i = 0; i < g.light.count; ++i) v.local.v[i] = v.frame.to_local(Vec3<T>(g.light.vertices[i] - g.shading.position));
+  for (int i = 0; i < g.light.count; ++i) {
+    Vec3<T> l = v.frame.to_local(Vec3<T>(g.light.vertices[i] - g.shading.position));
+    // A vertex within rounding of the horizon is on it: to_local's dot product carries an error of a few
+    // eps |V - x|. Left as it is, its clip point lies a rounding error away, and the edge between them has a
+    // normal made of rounding noise (found by fuzz_polygon_projected_double: samples up to 0.58 rad outside a
+    // polygon touching the horizon, issue 7).
+    if (std::abs(l.z()) <= T(8) * std::numeric_limits<T>::epsilon() * l.cwiseAbs().maxCoeff()) l.z() = T(0);
+    v.local.v[i] = l;
+  }
   return v;
 }
 

@@ -74,7 +74,46 @@ template <class T> struct EdgeEllipse {
     const T f = form(w, w);
     return f > T(0) ? nz * nz / f : T(0);
   }
+  // 1 - |p|^2 for the ellipse point p = w / sqrt(w^T C w), i.e. its z^2 on the hemisphere (Eq. 2), from the
+  // identity w^T Ct w - nz^2 |w|^2 = (nxy.w)^2: no cancellation near the horizon, where 1 - |p|^2 computed
+  // as a difference loses half the digits (found by fuzz_polygon_projected_double: samples 3.5e-9 rad below
+  // a clipped polygon's horizon vertex in double). A degenerate ellipse (f = 0) has p = 0.
+  T one_minus_radius2(const Vec2<T>& w) const {
+    const T f = form(w, w);
+    if (!(f > T(0))) return T(1);
+    const T d = nxy.dot(w);
+    return std::min(T(1), d * d / f);
+  }
 };
+
+// The boundary point of a sector at azimuth w on one edge, as (|p|^2, z^2) of the unit direction p (their sum
+// is 1). From the edge's own endpoints a, b (clipped, local frame) when known: the ray at azimuth w meets the
+// segment at a + t (b - a), t = (w x a) / ((w x a) - (w x b)) clamped to [0, 1] (w x a and w x b have opposite
+// signs inside the sector, so the denominator does not cancel). Mathematically this is the point of Eq. 3
+// (the ellipse is the edge's great circle projected), but it is well conditioned where the ellipse is a
+// needle: an edge whose great circle passes within rounding of the zenith has |n_z| ~ eps |n_xy|, and there
+// an azimuth error of eps moves Eq. 3's point along the needle by eps / |n_z|, past the edge's end (found by
+// fuzz_polygon_projected_double: the light's plane containing the normal, samples 0.23 rad outside; our
+// remedy, issue 7). Without endpoints (a = b = 0), Eq. 3.
+template <class T> void edge_boundary_point(const EdgeEllipse<T>& e, const Vec3<T>& a, const Vec3<T>& b,
+                                            const Vec2<T>& w, T* r2, T* z2) {
+  const T ca = kahan_cross2(w, Vec2<T>(a.x(), a.y())), cb = kahan_cross2(w, Vec2<T>(b.x(), b.y()));
+  const T den = ca - cb;
+  if (a != b && den != T(0) && std::isfinite(den)) {
+    const T t = std::clamp(ca / den, T(0), T(1));
+    const Vec3<T> p = a + t * (b - a);
+    const T m = p.cwiseAbs().maxCoeff();
+    if (m > T(0) && std::isfinite(m)) {
+      const Vec3<T> q = p / m;
+      const T n2 = q.squaredNorm();
+      *r2 = std::min(T(1), (q.x() * q.x() + q.y() * q.y()) / n2);
+      *z2 = std::min(T(1), q.z() * q.z() / n2);
+      return;
+    }
+  }
+  *r2 = std::min(T(1), e.inverse_quadratic(w) * w.squaredNorm());
+  *z2 = e.one_minus_radius2(w);
+}
 
 template <class T> EdgeEllipse<T> edge_ellipse(const Vec3<T>& n_unit) {
   return EdgeEllipse<T>{Vec2<T>(n_unit.x(), n_unit.y()), n_unit.z()};
@@ -93,6 +132,8 @@ T ellipse_sector_area(const EdgeEllipse<T>& e, const Vec2<T>& s0, const Vec2<T>&
 template <class T> struct ProjectedSector {
   Vec2<T> s0 = Vec2<T>::Zero(), s1 = Vec2<T>::Zero();  // boundaries, counterclockwise, at most 180 degrees
   EdgeEllipse<T> outer, inner;                          // inner only in the decentral case
+  Vec3<T> outer_a = Vec3<T>::Zero(), outer_b = Vec3<T>::Zero();  // the edges' clipped endpoints (local frame)
+  Vec3<T> inner_a = Vec3<T>::Zero(), inner_b = Vec3<T>::Zero();
   bool decentral = false;
   T area = 0;
 };
@@ -190,11 +231,22 @@ Vec2<T> decentral_iteration(const ProjectedSector<T>& s, T target, const Vec2<T>
   return l1_normalized(w);
 }
 
-// The decentral inversion: initialisation plus `iterations` steps.
+// The exact inverse lies in the sector [s0, s1] (the area from s0 grows monotonically across it), but where the
+// inner and outer ellipses (nearly) coincide, Eq. 5's coefficients are rounding noise and the root can leave
+// the sector; there the ray meets the ellipses with nxy.w of the wrong sign, i.e. on the great circle
+// mirrored in the horizon (found by fuzz_polygon_projected_double: a sliver polygon seen along its plane,
+// sample 7e-4 rad off the light, issue 7). We put such a w back on the nearer boundary.
+template <class T> Vec2<T> clamp_to_sector(const ProjectedSector<T>& s, const Vec2<T>& w) {
+  if (kahan_cross2(s.s0, w) < T(0)) return l1_normalized(s.s0);
+  if (kahan_cross2(w, s.s1) < T(0)) return l1_normalized(s.s1);
+  return w;
+}
+
+// The decentral inversion: initialisation plus `iterations` steps, each kept inside the sector.
 template <class T, bool kBiased = false>
 Vec2<T> invert_decentral_sector(const ProjectedSector<T>& s, T target, int iterations) {
-  Vec2<T> w = decentral_initialization<T, kBiased>(s, target);
-  for (int k = 0; k < iterations; ++k) w = decentral_iteration<T, kBiased>(s, target, w);
+  Vec2<T> w = clamp_to_sector(s, decentral_initialization<T, kBiased>(s, target));
+  for (int k = 0; k < iterations; ++k) w = clamp_to_sector(s, decentral_iteration<T, kBiased>(s, target, w));
   return w;
 }
 
@@ -270,6 +322,7 @@ template <class T, bool kBiased = false> PolygonProjectedView<T> make_polygon_pr
     for (int j = 0; j < m; ++j) {
       ProjectedSector<T>& s = v.sectors[v.sector_count++];
       s.s0 = xy(j), s.s1 = xy(j + 1), s.outer = ell[j];
+      s.outer_a = v.clipped.v[j], s.outer_b = v.clipped.v[(j + 1) % m];
       s.area = std::max(T(0), ellipse_sector_area<T, kBiased>(s.outer, s.s0, s.s1, v.edge_normals[j].z()));
     }
   } else {
@@ -294,6 +347,8 @@ template <class T, bool kBiased = false> PolygonProjectedView<T> make_polygon_pr
       ProjectedSector<T>& s = v.sectors[v.sector_count++];
       s.decentral = true;
       s.outer = ell[oe[a]], s.inner = ell[ie[bi]];
+      s.outer_a = v.clipped.v[oe[a]], s.outer_b = v.clipped.v[(oe[a] + 1) % m];
+      s.inner_a = v.clipped.v[ie[bi]], s.inner_b = v.clipped.v[(ie[bi] + 1) % m];
       s.s0 = cur;
       if (order > T(0)) s.s1 = next_o, ++a;
       else if (order < T(0)) s.s1 = next_i, ++bi;
@@ -307,7 +362,10 @@ template <class T, bool kBiased = false> PolygonProjectedView<T> make_polygon_pr
   }
   T total = 0;
   for (int k = 0; k < v.sector_count; ++k) total += v.sectors[k].area;
-  if (!(total > T(0)) || !std::isfinite(total)) return v.reason = NoSample::kTooSmall, v;
+  // The density cos / A_Sigma must be representable too: a light 1e154 away has A_Sigma ~ 1e-308 and 1 / A_Sigma
+  // overflows (found by fuzz_polygon_projected_double, issue 7).
+  if (!(total > T(0)) || !std::isfinite(total) || !std::isfinite(T(1) / total))
+    return v.reason = NoSample::kTooSmall, v;
   v.projected_solid_angle = total;
   return v;
 }
@@ -341,20 +399,24 @@ DirectionSample<T> sample_polygon_projected_solid_angle(const PolygonProjectedVi
   if (k < 0) return DirectionSample<T>::none(NoSample::kTooSmall);
   const ProjectedSector<T>& s = v.sectors[k];
   target = std::clamp(target, T(0), s.area);
+  // Sec. 3.2 / 3.3: the squared radius is interpolated linearly in xi_1 between the inner boundary (the
+  // origin in the central case) and the outer one, r^2 = (1 - xi_1) r_i^2 + xi_1 r_o^2 (with r^2 = 1 / (w^T C w)
+  // for unit w, Eq. 3); z^2 = 1 - r^2 is interpolated in the same way, from each boundary's own z^2 (no
+  // cancellation near the horizon). Boundary points from the edges' endpoints: edge_boundary_point.
   Vec2<T> w;
-  T rho2;  // rho^2 with w of unit "length" in the sense of the 1 / (w^T C w) factors
+  T ri2 = 0, zi2 = 1, ro2, zo2;
   if (!s.decentral) {
     w = invert_central_sector(s, target);
-    rho2 = u[1] * s.outer.inverse_quadratic(w);  // Sec. 3.2: rho^2 = xi_1 / (w^T C w)
   } else {
     w = invert_decentral_sector<T, kBiased>(s, target, iterations);
-    // Sec. 3.3: rho^2 = (1 - xi_1) / (w^T C_i w) + xi_1 / (w^T C_o w)
-    rho2 = (T(1) - u[1]) * s.inner.inverse_quadratic(w) + u[1] * s.outer.inverse_quadratic(w);
+    edge_boundary_point(s.inner, s.inner_a, s.inner_b, w, &ri2, &zi2);
   }
+  edge_boundary_point(s.outer, s.outer_a, s.outer_b, w, &ro2, &zo2);
+  const T r2 = (T(1) - u[1]) * ri2 + u[1] * ro2, z2 = (T(1) - u[1]) * zi2 + u[1] * zo2;
   // Eq. 2: project up to the hemisphere.
-  const T r2 = std::min(T(1), rho2 * w.squaredNorm());
-  const T rho = std::sqrt(rho2);
-  const Vec3<T> local(rho * w.x(), rho * w.y(), std::sqrt(std::max(T(0), T(1) - r2)));
+  const T wn = w.norm();
+  const T rho = wn > T(0) ? std::sqrt(r2) / wn : T(0);
+  const Vec3<T> local(rho * w.x(), rho * w.y(), std::sqrt(std::max(T(0), z2)));
   DirectionSample<T> out;
   out.direction = safe_normalized(v.to_world(local));
   if (out.direction.isZero()) return DirectionSample<T>::none(NoSample::kTooSmall);

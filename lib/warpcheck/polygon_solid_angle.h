@@ -22,7 +22,12 @@ template <class T> struct PolygonFanView {
   std::array<Vec3<T>, kMaxClippedVertices> p{};       // vertex - shading point
   std::array<Vec3<T>, kMaxClippedVertices> e{};       // p_k - p_0, from the light's own vertices if unclipped
   std::array<Vec3<T>, kMaxClippedVertices> u{};       // p_k / |p_k|
-  std::array<Vec3<T>, kMaxClippedVertices> inward{};  // p_j x p_{j+1}: the cone is {w : inward_j . w >= 0}
+  // The cone is {w : inward_j . w >= 0, j < planes}: unclipped, inward_j = p_j x p_{j+1}; clipped, the
+  // light's own edge planes (from V_j - x) and the horizon, never planes through two clip points, whose
+  // normal is undetermined when the clip points (nearly) coincide (found by fuzz_polygon_solid_angle_double:
+  // pdf 0 for a sample 2e-10 rad inside the clipped polygon).
+  std::array<Vec3<T>, kMaxClippedVertices> inward{};
+  int planes = 0;
   Vec3<T> plane_normal = Vec3<T>::Zero();             // unit
   T plane_distance = 0;                               // |plane_normal . p_0| > 0
   bool valid() const { return reason == NoSample::kNone; }
@@ -67,12 +72,23 @@ template <class T> PolygonFanView<T> make_polygon_fan_view(const PolygonLightGeo
     f.u[k] = safe_normalized(f.p[k]);
     if (f.u[k].isZero()) return f.reason = NoSample::kNonFinite, f;
   }
-  for (int j = 0; j < f.count; ++j) f.inward[j] = kahan_cross(f.p[j], f.p[(j + 1) % f.count]);
+  if (!clipped) {
+    f.planes = f.count;
+    for (int j = 0; j < f.count; ++j) f.inward[j] = kahan_cross(f.p[j], f.p[(j + 1) % f.count]);
+  } else {
+    const int m = g.light.count;
+    const T orient = reverse ? T(-1) : T(1);
+    for (int j = 0; j < m; ++j)
+      f.inward[j] = orient * kahan_cross(Vec3<T>(g.light.vertices[j] - g.shading.position),
+                                         Vec3<T>(g.light.vertices[(j + 1) % m] - g.light.vertices[j]));
+    f.inward[m] = pv.normal;  // m <= kMaxPolygonVertices = kMaxClippedVertices - 1
+    f.planes = m + 1;
+  }
   return f;
 }
 
 template <class T> bool in_fan_cone(const PolygonFanView<T>& f, const Vec3<T>& w) {
-  for (int j = 0; j < f.count; ++j)
+  for (int j = 0; j < f.planes; ++j)
     if (f.inward[j].dot(w) < T(0)) return false;
   return true;
 }
@@ -104,7 +120,9 @@ template <class T> PolygonSolidAngleView<T> make_polygon_solid_angle_view(const 
     v.area[k] = std::max(T(0), T(2) * std::atan2(v.g0[k], denom));
     v.solid_angle += v.area[k];
   }
-  if (!(v.solid_angle > T(0)) || !std::isfinite(v.solid_angle)) v.reason = NoSample::kTooSmall;
+  // 1 / Omega must be representable too (as for the projected solid angle; issue 7).
+  if (!(v.solid_angle > T(0)) || !std::isfinite(v.solid_angle) || !std::isfinite(T(1) / v.solid_angle))
+    v.reason = NoSample::kTooSmall;
   return v;
 }
 
