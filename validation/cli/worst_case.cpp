@@ -1,0 +1,234 @@
+// warpcheck worst-case / warpcheck merge: run a worst-case error search (validation/.../searches.h),
+// resumably and shardably, and combine shard results.
+#include <csignal>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include "commands.h"
+#include "warpcheck/validation/searches.h"
+
+namespace warpcheck::cli {
+
+using namespace warpcheck::validation;
+
+namespace {
+
+const char* kWorstCaseHelp = R"(usage: warpcheck worst-case --search NAME [options]
+       warpcheck worst-case --list
+
+Maximises an error measure with multi-start Nelder-Mead in long double and reports the worst input found.
+
+  --search NAME        the search to run (see --list)
+  --seconds T          total wall-clock budget in seconds, counted over resumes (default 60)
+  --threads N          worker threads (default 1)
+  --seed S             seed; chain c of the search is a pure function of (S, c) (default 1)
+  --shard I/N          run only chains c with c mod N == I (default 0/1); shards with the same seed are disjoint
+  --checkpoint FILE    resume from FILE if it exists, and rewrite it atomically every --checkpoint-every
+                       seconds, within 0.25 s of every improvement of the best-so-far, and at the end; a run
+                       killed (even by SIGKILL) and restarted with the same command loses no best-so-far and
+                       continues with the chains not yet done
+  --checkpoint-every S seconds between checkpoint writes (default 10)
+  --progress S         seconds between progress lines on stderr (default 5; 0 = none)
+  --json FILE          write the result there (atomically) instead of to stdout
+  --list               list the searches with their parameter boxes and exit
+  --evaluate FILE      print the objective of --search at the input recorded in FILE (a result, checkpoint
+                       or data/worst-cases record of a search with the same parameters) and exit
+
+SIGINT/SIGTERM stop the run early; the checkpoint and result are still written. Exit status: 0 done,
+1 runtime error (e.g. unreadable checkpoint), 2 bad arguments.
+)";
+
+const char* kMergeHelp = R"(usage: warpcheck merge FILE... [--json OUT]
+
+Combines results or checkpoints of one search (shards, separate runs): the worst case over all of them, the
+sums of evaluations, chains and seconds. Writes JSON to OUT (atomically) or stdout. Exit status: 0 done,
+1 unreadable or mismatched files, 2 bad arguments.
+)";
+
+// The signal handler can only reach a flag with static storage; this is the CLI process's one such flag.
+std::atomic<bool> g_stop{false};
+extern "C" void on_stop_signal(int) { g_stop.store(true); }
+
+std::string read_file(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) throw std::runtime_error("cannot read " + path);
+  std::ostringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+bool file_exists(const std::string& path) { return static_cast<bool>(std::ifstream(path)); }
+
+void list_searches() {
+  for (const Search& s : all_searches()) {
+    std::printf("%s\n  %s\n", s.name.c_str(), s.description.c_str());
+    if (!s.paper.empty()) std::printf("  paper: %s\n", s.paper.c_str());
+    for (const auto& p : s.parameters)
+      std::printf("    %-28s [%Lg, %Lg]  %s\n", p.name.c_str(), p.lo, p.hi, p.meaning.c_str());
+  }
+}
+
+std::string joined(const char* head, const std::vector<std::string>& args) {
+  std::string c = head;
+  for (const auto& a : args) c += " " + a;
+  return c;
+}
+
+}  // namespace
+
+int worst_case_main(const std::vector<std::string>& args) {
+  std::string name, checkpoint, json, evaluate;
+  double seconds = 60, checkpoint_every = 10, progress = 5;
+  int threads = 1;
+  std::uint64_t seed = 1, shard_index = 0, shard_count = 1;
+  bool list = false;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    auto value = [&]() -> const std::string& {
+      if (i + 1 >= args.size()) throw UsageError(a + " needs a value");
+      return args[++i];
+    };
+    if (a == "--help" || a == "-h") {
+      std::fputs(kWorstCaseHelp, stdout);
+      return 0;
+    } else if (a == "--list") list = true;
+    else if (a == "--search") name = value();
+    else if (a == "--seconds") seconds = parse_double(a, value(), 0, 1e9);
+    else if (a == "--threads") threads = int(parse_u64(a, value(), 1, 1024));
+    else if (a == "--seed") seed = parse_u64(a, value(), 0, UINT64_MAX);
+    else if (a == "--checkpoint") checkpoint = value();
+    else if (a == "--checkpoint-every") checkpoint_every = parse_double(a, value(), 0.1, 1e9);
+    else if (a == "--progress") progress = parse_double(a, value(), 0, 1e9);
+    else if (a == "--json") json = value();
+    else if (a == "--evaluate") evaluate = value();
+    else if (a == "--shard") {
+      const std::string v = value();
+      const auto slash = v.find('/');
+      if (slash == std::string::npos) throw UsageError("--shard needs I/N, e.g. 3/8, got '" + v + "'");
+      shard_count = parse_u64("--shard N", v.substr(slash + 1), 1, UINT32_MAX);
+      shard_index = parse_u64("--shard I", v.substr(0, slash), 0, shard_count - 1);
+    } else throw UsageError("unknown option '" + a + "'");
+  }
+  if (list) {
+    list_searches();
+    return 0;
+  }
+  if (name.empty()) throw UsageError("--search NAME is required (see --list)");
+  const std::optional<Search> search = find_search(name);
+  if (!search) throw UsageError("unknown search '" + name + "' (see --list)");
+  if (!evaluate.empty()) {
+    SearchRecord r;
+    try {
+      r = record_from_json(read_file(evaluate));
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "warpcheck worst-case: %s: %s\n", evaluate.c_str(), e.what());
+      return 1;
+    }
+    const std::optional<Search> from = find_search(r.search);
+    bool same = from && from->parameters.size() == search->parameters.size();
+    for (std::size_t i = 0; same && i < search->parameters.size(); ++i) same = from->parameters[i].name == search->parameters[i].name;
+    if (!same) throw UsageError(evaluate + " holds an input of '" + r.search + "', whose parameters differ from '" + name + "'s");
+    if (r.best_x.empty()) throw UsageError(evaluate + " holds no input");
+    std::printf("%s at the input of %s: %.6Le\n", name.c_str(), evaluate.c_str(), search->objective(r.best_x));
+    return 0;
+  }
+
+  SearchRecord state;
+  state.search = name, state.seed = seed, state.shard_index = shard_index, state.shard_count = shard_count;
+  if (!checkpoint.empty() && file_exists(checkpoint)) {
+    try {
+      state = record_from_json(read_file(checkpoint));
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "warpcheck worst-case: checkpoint %s: %s\n", checkpoint.c_str(), e.what());
+      return 1;
+    }
+    if (state.search != name || state.seed != seed || state.shard_index != shard_index || state.shard_count != shard_count)
+      throw UsageError("checkpoint " + checkpoint + " belongs to search '" + state.search + "' seed " +
+                       std::to_string(state.seed) + " shard " + std::to_string(state.shard_index) + "/" +
+                       std::to_string(state.shard_count) + ", not to this command");
+    std::fprintf(stderr, "resuming from %s: %.1f s, %llu chains, best %.3Le\n", checkpoint.c_str(), state.seconds,
+                 (unsigned long long)state.chains, state.best_f);
+  }
+  state.kernel_version = source_version();
+  state.command = joined("warpcheck worst-case", args);
+  state.target_seconds = seconds;
+
+  std::signal(SIGINT, on_stop_signal);
+  std::signal(SIGTERM, on_stop_signal);
+  RunOptions o;
+  o.seconds = seconds;
+  o.threads = threads;
+  o.stop = &g_stop;
+  o.tick_seconds = 0.25;
+  double last_checkpoint = state.seconds, last_progress = state.seconds;
+  std::size_t checkpointed_improvements = state.history.size();
+  o.tick = [&](const SearchRecord& snap, double rate) {
+    // Periodically, and at the next tick (0.25 s) after every improvement of the best-so-far.
+    if (!checkpoint.empty() &&
+        (snap.seconds - last_checkpoint >= checkpoint_every || snap.history.size() != checkpointed_improvements)) {
+      write_file_atomically(checkpoint, to_json(snap, &*search));
+      last_checkpoint = snap.seconds;
+      checkpointed_improvements = snap.history.size();
+    }
+    if (progress > 0 && snap.seconds - last_progress >= progress) {
+      std::fprintf(stderr, "[%s %llu/%llu] %.0f/%.0f s  chains %llu  evals %lld (%.3g/s)  best %.4Le\n", name.c_str(),
+                   (unsigned long long)snap.shard_index, (unsigned long long)snap.shard_count, snap.seconds, seconds,
+                   (unsigned long long)snap.chains, snap.evaluations, rate, snap.best_f);
+      last_progress = snap.seconds;
+    }
+  };
+  try {
+    run_search(*search, state, o);
+    const std::string text = to_json(state, &*search);
+    if (!checkpoint.empty()) write_file_atomically(checkpoint, text);
+    if (json.empty()) std::fputs(text.c_str(), stdout);
+    else write_file_atomically(json, text);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "warpcheck worst-case: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
+
+int merge_main(const std::vector<std::string>& args) {
+  std::vector<std::string> files;
+  std::string json;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    if (args[i] == "--help" || args[i] == "-h") {
+      std::fputs(kMergeHelp, stdout);
+      return 0;
+    } else if (args[i] == "--json") {
+      if (i + 1 >= args.size()) throw UsageError("--json needs a value");
+      json = args[++i];
+    } else if (!args[i].empty() && args[i][0] == '-') {
+      throw UsageError("unknown option '" + args[i] + "'");
+    } else {
+      files.push_back(args[i]);
+    }
+  }
+  if (files.empty()) throw UsageError("no files to merge");
+  try {
+    std::vector<SearchRecord> records;
+    for (const auto& f : files) {
+      try {
+        records.push_back(record_from_json(read_file(f)));
+      } catch (const std::exception& e) {
+        throw std::runtime_error(f + ": " + e.what());
+      }
+    }
+    SearchRecord m = merge_records(records);
+    m.merged_from = files;
+    m.command = joined("warpcheck merge", args);
+    const std::optional<Search> s = find_search(m.search);
+    const std::string text = to_json(m, s ? &*s : nullptr);
+    if (json.empty()) std::fputs(text.c_str(), stdout);
+    else write_file_atomically(json, text);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "warpcheck merge: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace warpcheck::cli
