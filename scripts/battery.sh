@@ -8,4 +8,5 @@ mkdir -p "$ROOT/results"
 status=0
 "$BUILD_DIR/warpcheck" validate --json "$ROOT/results/results.json" "$@" || status=$?
 echo "[battery] results in $ROOT/results/results.json (exit $status)"
+"$BUILD_DIR/warpcheck" report --out "$ROOT/results/report" --from "$ROOT/results/results.json" --data "$ROOT/data"
 exit $status

@@ -1,0 +1,141 @@
+// warpcheck/validation/report.h: the HTML report (`warpcheck report`, issue 8).
+//
+// write_report() turns a battery results JSON (`warpcheck validate --json`, battery.h to_json) and whatever
+// the data directory holds (claims, worst cases, fuzz summary, benchmarks) into a static, offline site:
+//   index.html        pass/fail matrix (kernel x scalar x config by test), the failing list first, alpha and
+//                     correction; then the data sections (claims beside the paper, worst cases, fuzz, bench)
+//   kernel-<k>.html   one page per kernel: its results, per chi2 test the observed / expected / signed
+//                     residual maps (PNG in the page, 32-bit float OpenEXR beside it), and sample sets (a grid
+//                     and a blue-noise set in primary sample space mapped by the kernel) as inline SVG
+// A missing optional input gives a section that says "not run" and the command that produces it.
+//
+// The pieces are exposed so tests can check them one by one.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "warpcheck/validation/sampler.h"
+
+namespace warpcheck::validation::report {
+
+// ---- Model: the battery results JSON ------------------------------------------------------------------------
+
+struct Result {
+  std::string kernel, scalar, config, test;
+  std::optional<double> statistic;  // null in the JSON when NaN (e.g. a battery that threw)
+  std::optional<double> p_value;    // null for deterministic tests
+  bool passed = false;
+  std::string detail, known_limitation;
+  int map_rows = 0, map_cols = 0;   // chi2 only: the grid over the bounding cap (battery.h TestResult)
+  std::vector<double> observed, expected;
+
+  // Failed and not a documented limitation: this fails the run.
+  bool failed() const { return !passed && known_limitation.empty(); }
+};
+
+struct BatteryRun {
+  double alpha = 0;
+  std::string correction;
+  long long statistical_tests = 0;
+  std::optional<long long> samples, seed;
+  std::optional<bool> complete;
+  std::vector<Result> results;
+};
+
+// Parses the JSON text written by battery.h to_json (with the CLI's extra members). Throws std::runtime_error
+// naming the first missing or mistyped member.
+BatteryRun parse_battery_json(const std::string& text);
+
+// ---- Images ----------------------------------------------------------------------------------------------------
+
+struct Image {
+  int width = 0, height = 0;
+  std::vector<std::uint8_t> rgba;  // row-major, 4 bytes per pixel
+};
+
+using Rgb = std::array<std::uint8_t, 3>;
+// Sequential colour map for counts, t in [0, 1] (dark blue -> yellow, piecewise linear through viridis-like
+// stops), and a diverging one for residuals, t in [-1, 1] (blue -> white -> red).
+Rgb sequential_color(double t);
+Rgb diverging_color(double t);
+
+// A chi2 grid drawn as the bounding cap seen from above in an equal-area projection: pixel (x, y) of a
+// size x size image at disk radius rho = sqrt(t), azimuth phi (counter-clockwise from +x, +y up) shows
+// values[row(t) * cols + col(phi)] through color(value); equal-area bins therefore cover equal pixel areas.
+// Outside the disk the image is transparent. With `ring`, the disk is drawn at 90% of the radius and a ring
+// around it shows color(*ring): the samples that fell off the grid (outside the bounding cap, or declined).
+Image polar_map(int rows, int cols, const std::vector<double>& values, int size,
+                const std::function<Rgb(double)>& color, std::optional<double> ring = std::nullopt);
+
+// Writes an 8-bit RGBA PNG (libpng). Throws std::runtime_error on failure.
+void write_png(const std::string& path, const Image& image);
+// Writes a scanline OpenEXR file with one 32-bit FLOAT channel per (name, values) (values row-major, width x
+// height). Throws std::runtime_error (after catching OpenEXR's exceptions) on failure.
+void write_exr(const std::string& path, int width, int height,
+               const std::vector<std::pair<std::string, std::vector<float>>>& channels);
+// Reads a channel back (for tests): the values, row-major.
+std::vector<float> read_exr_channel(const std::string& path, const std::string& channel, int& width, int& height);
+
+// ---- Sample sets -------------------------------------------------------------------------------------------------
+
+// n x n cell centres of the unit square, row-major in u1 then u0.
+std::vector<std::array<double, 2>> regular_grid(int n);
+// n points of the unit square by Mitchell's best-candidate algorithm (each new point is the farthest, in the
+// toroidal metric, from the points placed so far among `candidates` uniform candidates), from a fixed seed.
+// O(n^2 candidates): about 3e7 distance evaluations for the report's 1024 points.
+std::vector<std::array<double, 2>> best_candidate_blue_noise(int n, std::uint64_t seed, int candidates = 32);
+
+struct MappedPoint {
+  double x = 0, y = 0;   // equal-area projection of the direction into the bounding cap's frame: sqrt(t) (cos, sin)
+  bool valid = false;    // the sampler returned a sample
+  bool outside = false;  // the direction lies outside the bounding cap (t > 1)
+};
+std::vector<MappedPoint> map_points(const SamplerUnderTest& s, const std::vector<std::array<double, 2>>& u);
+
+// Inline SVG of a sample set: primary sample space on the left, the mapped directions on the right (unit
+// disk = bounding cap), points coloured by their (u0, u1) so the correspondence shows. With grid_lines, the
+// points are polylines of `line_samples` points along each of `lines` lines u0 = const and u1 = const.
+std::string sample_set_svg(const SamplerUnderTest& s, const std::vector<std::array<double, 2>>& points,
+                           const std::string& title);
+std::string grid_lines_svg(const SamplerUnderTest& s, int lines, int line_samples, const std::string& title);
+
+// ---- Plots ---------------------------------------------------------------------------------------------------
+
+struct Series {
+  std::string name;
+  std::vector<std::pair<double, double>> points;
+};
+// A self-contained inline SVG line plot (axes, ticks, legend). Non-finite points and, on log axes,
+// non-positive ones are skipped.
+std::string svg_line_plot(const std::vector<Series>& series, const std::string& title, const std::string& xlabel,
+                          const std::string& ylabel, bool log_x, bool log_y, int width = 520, int height = 300);
+
+// ---- The site ----------------------------------------------------------------------------------------------------
+
+struct ReportOptions {
+  std::string out_dir;       // created if missing
+  std::string results_path;  // battery JSON (required)
+  std::string data_dir;      // claims, worst cases, fuzz, bench; empty: no data sections read
+  int sample_cases_per_kernel = 3;  // registry cases drawn as sample sets per kernel
+  int grid_lines = 17, grid_line_samples = 96, blue_noise_points = 1024;
+};
+
+struct ReportSummary {
+  std::size_t kernels = 0, results = 0, failures = 0, known_limitation_failures = 0;
+  std::vector<std::string> files;  // every file written, relative to out_dir
+};
+
+ReportSummary write_report(const ReportOptions& options);
+
+// HTML-escapes text (&, <, >, ", ').
+std::string html_escape(const std::string& s);
+// A file name for a kernel page / image prefix: [A-Za-z0-9._-] kept, anything else '_'.
+std::string safe_name(const std::string& s);
+
+}  // namespace warpcheck::validation::report
