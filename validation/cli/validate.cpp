@@ -6,6 +6,9 @@
 #include <fstream>
 #include <sstream>
 
+#include <boost/json.hpp>
+#include <set>
+
 #include "commands.h"
 #include "warpcheck/validation/battery.h"
 #include "warpcheck/validation/negative_controls.h"
@@ -68,7 +71,7 @@ const char* kListHelp =
 const char* kValidateHelp =
     "usage: warpcheck validate [--kernel GLOB]... [--config GLOB]... [--scalar GLOB]... [--samples N]\n"
     "                          [--seed S] [--alpha A] [--correction holm|sidak] [--threads N] [--json FILE]\n"
-    "                          [--quiet] [--negative-controls]\n"
+    "                          [--quiet] [--negative-controls] [--resume]\n"
     "\n"
     "Runs the battery (chi2, ks-radial, ks-azimuth, pdf-integral, pdf-consistency, normalization:*) on every\n"
     "selected kernel and configuration and prints a table: kernel, scalar, config, test, statistic, p-value,\n"
@@ -85,6 +88,8 @@ const char* kValidateHelp =
     "  --json FILE       also write {\"alpha\",\"correction\",\"results\":[...]}; rewritten atomically after each\n"
     "                    case with \"complete\": false, so a killed run keeps what it finished\n"
     "  --quiet           no progress on stderr\n"
+    "  --resume          with --json: keep the cases already in FILE (from a killed run with the same --samples\n"
+    "                    and --seed) and run only the others; the correction is recomputed over all of them\n"
     "  --negative-controls  run the deliberately broken samplers instead of the registered kernels (each\n"
     "                    must FAIL; the exit status is then 1 when the battery works)\n"
     "\n"
@@ -136,13 +141,58 @@ int list_main(const std::vector<std::string>& a) {
   return 0;
 }
 
+std::string case_key(const std::string& kernel, const std::string& scalar, const std::string& config) {
+  return kernel + '\x1f' + scalar + '\x1f' + config;
+}
+
+// Results of an earlier run (the --json file of a killed or finished run) to continue from. The file must come
+// from the same --samples and --seed: mixing sample counts would make the run's verdicts meaningless.
+std::vector<TestResult> load_results_to_resume(const std::string& path, std::uint64_t samples, std::uint64_t seed,
+                                               std::set<std::string>& done) {
+  std::ifstream in(path);
+  if (!in) return {};  // nothing to resume: start afresh
+  std::stringstream text;
+  text << in.rdbuf();
+  if (text.str().empty()) return {};
+  boost::system::error_code ec;
+  const boost::json::value v = boost::json::parse(text.str(), ec);
+  if (ec || !v.is_object() || !v.as_object().contains("results"))
+    throw UsageError("cannot resume: '" + path + "' is not a warpcheck validate --json file");
+  const auto& o = v.as_object();
+  auto u64 = [&](const char* k) { return o.contains(k) ? boost::json::value_to<std::uint64_t>(o.at(k)) : 0; };
+  if (u64("samples") != samples || u64("seed") != seed)
+    throw UsageError("cannot resume: '" + path + "' was written with --samples " + std::to_string(u64("samples")) +
+                     " --seed " + std::to_string(u64("seed")) + "; give the same values");
+  std::vector<TestResult> out;
+  for (const auto& e : o.at("results").as_array()) {
+    const auto& r = e.as_object();
+    TestResult t;
+    auto str = [&](const char* k) { return r.contains(k) ? std::string(r.at(k).as_string()) : std::string(); };
+    t.kernel = str("kernel"), t.scalar = str("scalar"), t.config = str("config"), t.test = str("test");
+    t.detail = str("detail"), t.known_limitation = str("known_limitation");
+    t.statistic = r.at("statistic").is_null() ? std::numeric_limits<double>::quiet_NaN()
+                                              : boost::json::value_to<double>(r.at("statistic"));
+    if (!r.at("p_value").is_null()) t.p_value = boost::json::value_to<double>(r.at("p_value"));
+    else t.passed = r.at("passed").as_bool();  // deterministic verdicts are kept; statistical ones re-judged
+    if (r.contains("map")) {
+      const auto& m = r.at("map").as_object();
+      t.map_rows = int(m.at("rows").to_number<double>()), t.map_cols = int(m.at("cols").to_number<double>());
+      for (const auto& x : m.at("observed").as_array()) t.observed.push_back(x.to_number<double>());
+      for (const auto& x : m.at("expected").as_array()) t.expected.push_back(x.to_number<double>());
+    }
+    done.insert(case_key(t.kernel, t.scalar, t.config));
+    out.push_back(std::move(t));
+  }
+  return out;
+}
+
 int validate_main(const std::vector<std::string>& a) {
   Selection sel;
   BatteryOptions opt;
   double alpha = 0.01;
   Correction corr = Correction::kHolm;
   std::string json;
-  bool quiet = false, negative = false;
+  bool quiet = false, negative = false, resume = false;
   for (std::size_t i = 0; i < a.size(); ++i) {
     const std::string& f = a[i];
     auto value = [&]() -> const std::string& {
@@ -173,18 +223,29 @@ int validate_main(const std::vector<std::string>& a) {
       quiet = true;
     } else if (f == "--negative-controls") {
       negative = true;
+    } else if (f == "--resume") {
+      resume = true;
     } else {
       throw UsageError("unknown option '" + f + "'");
     }
   }
+  if (resume && json.empty()) throw UsageError("--resume needs --json FILE (the file of the run to resume)");
   const Registry reg = negative ? negative_control_registry() : default_registry();
-  const std::vector<const Case*> cases = select_cases(reg, sel);
+  std::vector<const Case*> cases = select_cases(reg, sel);
+  std::vector<TestResult> all;
+  if (resume) {
+    std::set<std::string> done;
+    all = load_results_to_resume(json, opt.samples, opt.seed, done);
+    const std::size_t before = cases.size();
+    std::erase_if(cases, [&](const Case* c) { return done.count(case_key(c->kernel, c->scalar, c->config)) > 0; });
+    std::fprintf(stderr, "resuming %s: %zu cases done, %zu to run\n", json.c_str(), before - cases.size(),
+                 cases.size());
+  }
   if (!json.empty()) {  // fail on an unwritable path now, not after an hour of work
     std::ofstream probe(json, std::ios::app);
     if (!probe) throw UsageError("cannot write --json file '" + json + "'");
   }
   const bool tty = ::isatty(2);
-  std::vector<TestResult> all;
   std::ostringstream meta;
   meta << "\"samples\":" << opt.samples << ",\"seed\":" << opt.seed;
   const auto start = std::chrono::steady_clock::now();

@@ -86,17 +86,22 @@ struct QuadratureResult {
 
 // Globally adaptive Gauss-Kronrod on [a, b]: splits the panel with the largest error until the summed error
 // is at most max(abs_tol, rel_tol |value|) or max_panels panels exist. Never loops forever on noisy f.
+// initial_panels > 1 starts from that many equal panels (so a narrow feature of f cannot fall between the
+// first rule's nodes); 1 starts from [a, b] split once.
 QuadratureResult integrate_adaptive(const std::function<Real(Real)>& f, Real a, Real b, Real rel_tol, Real abs_tol,
-                                    int max_panels);
+                                    int max_panels, int initial_panels = 1);
 
 // Integral of f over the region {w : t in [t0, t1], phi in [phi0, phi1]} of a cap's frame, where
 // t = (1 - cos theta) / cap.one_minus_cos (so t in [0, 1] spans the cap; t up to 2 / one_minus_cos reaches
 // the antipode), by nested globally adaptive Gauss-Kronrod in long double, to relative accuracy ~tol where the
 // panel budget allows (a jump of f across the region, a light's edge, costs ~30 bisections per line).
+// azimuth_panels: initial panels of the outer (azimuth) integral; wide regions of a thin support (a polygon's
+// sliver of a corner inside a full ring) need one per chi-square column or the first rule misses the support.
 QuadratureResult integrate_cap_region_with_error(const std::function<Real(const Vec3L&)>& f, const Cap<Real>& cap,
-                                                 Real t0, Real t1, Real phi0, Real phi1, Real tol = 1e-10L);
+                                                 Real t0, Real t1, Real phi0, Real phi1, Real tol = 1e-10L,
+                                                 int azimuth_panels = 1);
 Real integrate_cap_region(const std::function<Real(const Vec3L&)>& f, const Cap<Real>& cap, Real t0, Real t1,
-                          Real phi0, Real phi1, Real tol = 1e-10L);
+                          Real phi0, Real phi1, Real tol = 1e-10L, int azimuth_panels = 1);
 
 // The direction with coordinates (t, phi) in the cap's frame, and back.
 Vec3L cap_direction(const Cap<Real>& cap, Real t, Real phi);
