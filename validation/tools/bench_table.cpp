@@ -1,0 +1,137 @@
+// bench_table: the ratio table of issue 9 from Google Benchmark JSON (written by build/warpcheck_bench).
+//
+//   scripts/bench.sh                                  (runs the benchmarks, then this tool)
+//   build/bench_table data/bench/results.json [--markdown]
+//
+// Per-sample time t = 1 / items_per_second (CPU time) of each benchmark; the baseline of the same scalar,
+// configuration and samples-per-light mode (sphere_baseline / polygon_baseline: reading the random numbers and
+// the geometry only) is subtracted, as the papers do. Ratios:
+//   projected_cap / sphere_solid_angle          per q_z, 1 and 500 samples per light (target at 500: <= 2)
+//   polygon_projected / polygon_solid_angle     per vertex count, central and decentral (target decentral: <= 4)
+//   sphere_solid_angle / sphere_solid_angle_batch  per q_z at 500 (speed-up of the batch; target float: >= 3)
+// beside the papers' ratios, computed from the published tables (not measured by us):
+//   Peters & Dachsbacher 2019 Table 2 (offline renderer, ns per sample, baseline row subtracted):
+//     (ours - baseline) / (solid angle - baseline);
+//   Peters 2021 Table 1 (ms per frame, baseline already subtracted there): "Proj., ours" / "Solid angle, ours",
+//     "128 lights" for 1 sample per light and "128 samples" for many.
+// Exit status 0 always when the file parses (the table reports targets; it is not a test).
+#include <boost/json.hpp>
+
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <optional>
+#include <sstream>
+#include <string>
+
+namespace {
+
+// Paper ratios (see header). 2019 Table 2: columns qz = 2, 0.1, -0.9 at 1 spl; 2, 0.1, -0.1, -0.9 at 500 spl.
+std::optional<double> paper_cap_ratio(const std::string& qz, int spl) {
+  struct Row { const char* qz; int spl; double base, solid, ours; };
+  static const Row rows[] = {
+      {"2", 1, 2.1, 8.2, 10.1},     {"0.1", 1, 2.1, 7.4, 12.9},   {"-0.9", 1, 2.2, 6.3, 15.1},
+      {"2", 500, 2.0, 4.8, 6.3},    {"0.1", 500, 2.1, 4.0, 6.4},  {"-0.1", 500, 2.0, 3.8, 8.4},
+      {"-0.9", 500, 2.1, 3.1, 8.4},
+  };
+  for (const Row& r : rows)
+    if (qz == r.qz && spl == r.spl) return (r.ours - r.base) / (r.solid - r.base);
+  return std::nullopt;
+}
+
+// 2021 Table 1 (baseline subtracted by the paper): {solid angle ours, proj central ours, proj decentral ours}.
+std::optional<double> paper_polygon_ratio(bool central, int n, int spl) {
+  if (n < 3 || n > 5) return std::nullopt;
+  static const double solid[2][3] = {{5.92, 8.06, 7.59}, {1.12, 1.32, 1.60}};
+  static const double proj_central[2][3] = {{8.07, 11.4, 13.9}, {2.13, 2.28, 2.76}};
+  static const double proj_decentral[2][3] = {{20.0, 28.9, 39.3}, {11.1, 11.5, 11.9}};
+  const int m = spl == 1 ? 0 : 1;
+  return (central ? proj_central : proj_decentral)[m][n - 3] / solid[m][n - 3];
+}
+
+std::string fmt(std::optional<double> v, const char* f = "%.2f") {
+  if (!v) return "-";
+  char b[32];
+  std::snprintf(b, sizeof b, f, *v);
+  return b;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    std::cerr << "usage: bench_table RESULTS.json\n";
+    return 2;
+  }
+  std::ifstream in(argv[1]);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  boost::json::value root;
+  try {
+    root = boost::json::parse(ss.str());
+  } catch (const std::exception& e) {
+    std::cerr << "bench_table: cannot parse " << argv[1] << ": " << e.what() << "\n";
+    return 2;
+  }
+  // name -> seconds per sample
+  std::map<std::string, double> t;
+  for (const auto& b : root.at("benchmarks").as_array()) {
+    const auto& o = b.as_object();
+    if (o.contains("run_type") && o.at("run_type").as_string() != "iteration") continue;
+    if (!o.contains("items_per_second")) continue;
+    t[std::string(o.at("name").as_string())] = 1.0 / o.at("items_per_second").to_number<double>();
+  }
+  auto net = [&](const std::string& kernel, const std::string& family, const std::string& rest) -> std::optional<double> {
+    const auto k = t.find(kernel + rest), base = t.find(family + "_baseline" + rest);
+    if (k == t.end() || base == t.end()) return std::nullopt;
+    return k->second - base->second;
+  };
+  auto ratio = [](std::optional<double> a, std::optional<double> b) -> std::optional<double> {
+    if (!a || !b || !(*b > 0)) return std::nullopt;
+    return *a / *b;
+  };
+
+  std::printf("Per-sample costs (ns, baseline subtracted) and ratios; measured from %s\n\n", argv[1]);
+  std::printf("Projected spherical cap / sphere solid angle (Peters & Dachsbacher 2019 Table 2 configurations)\n");
+  std::printf("%-7s %-5s %5s %10s %10s %8s %8s %7s\n", "scalar", "qz", "spl", "solid ns", "proj ns", "ratio", "paper", "<=2?");
+  for (const char* T : {"float", "double"})
+    for (int spl : {1, 500})
+      for (const char* qz : {"2", "0.1", "-0.1", "-0.9"}) {
+        const std::string rest = std::string("/") + T + "/qz=" + qz + "/spl=" + std::to_string(spl);
+        const auto s = net("sphere_solid_angle", "sphere", rest), p = net("projected_cap", "sphere", rest);
+        const auto r = ratio(p, s);
+        std::printf("%-7s %-5s %5d %10s %10s %8s %8s %7s\n", T, qz, spl, fmt(s ? std::optional(*s * 1e9) : std::nullopt).c_str(),
+                    fmt(p ? std::optional(*p * 1e9) : std::nullopt).c_str(), fmt(r).c_str(),
+                    fmt(paper_cap_ratio(qz, spl)).c_str(), spl == 500 && r ? (*r <= 2 ? "yes" : "NO") : "");
+      }
+
+  std::printf("\nPolygon projected / polygon solid angle (Peters 2021 Table 1 configurations)\n");
+  std::printf("%-7s %-12s %5s %10s %10s %8s %8s %7s\n", "scalar", "config", "spl", "solid ns", "proj ns", "ratio", "paper", "<=4?");
+  for (const char* T : {"float", "double"})
+    for (int spl : {1, 500})
+      for (bool central : {false, true})
+        for (int n : {3, 4, 5}) {
+          const std::string config = std::string(central ? "central-" : "decentral-") + std::to_string(n);
+          const std::string rest = std::string("/") + T + "/" + config + "/spl=" + std::to_string(spl);
+          const auto s = net("polygon_solid_angle", "polygon", rest), p = net("polygon_projected", "polygon", rest);
+          const auto r = ratio(p, s);
+          std::printf("%-7s %-12s %5d %10s %10s %8s %8s %7s\n", T, config.c_str(), spl,
+                      fmt(s ? std::optional(*s * 1e9) : std::nullopt).c_str(),
+                      fmt(p ? std::optional(*p * 1e9) : std::nullopt).c_str(), fmt(r).c_str(),
+                      fmt(paper_polygon_ratio(central, n, spl)).c_str(), !central && r ? (*r <= 4 ? "yes" : "NO") : "");
+        }
+
+  std::printf("\nBatch API speed-up: scalar sphere solid angle / batch, 500 samples per light (target float: >= 3)\n");
+  std::printf("%-7s %-5s %10s %10s %8s %7s\n", "scalar", "qz", "scalar ns", "batch ns", "speedup", ">=3?");
+  for (const char* T : {"float", "double"})
+    for (const char* qz : {"2", "0.1", "-0.1", "-0.9"}) {
+      const std::string rest = std::string("/") + T + "/qz=" + qz + "/spl=500";
+      const auto s = net("sphere_solid_angle", "sphere", rest), b = net("sphere_solid_angle_batch", "sphere", rest);
+      const auto r = ratio(s, b);
+      std::printf("%-7s %-5s %10s %10s %8s %7s\n", T, qz, fmt(s ? std::optional(*s * 1e9) : std::nullopt).c_str(),
+                  fmt(b ? std::optional(*b * 1e9) : std::nullopt).c_str(), fmt(r).c_str(),
+                  std::string(T) == "float" && r ? (*r >= 3 ? "yes" : "NO") : "");
+    }
+  return 0;
+}
