@@ -1,6 +1,7 @@
 // Polygon-light kernels (Peters 2021 and the published baselines) and their named configurations.
 #include <cmath>
 #include <functional>
+#include <vector>
 
 #include "warpcheck/polygon_projected.h"
 #include "warpcheck/polygon_solid_angle.h"
@@ -23,6 +24,33 @@ template <class T> Cap<T> cap_of_polygon(const PolygonLightGeometry<T>& g) {
   return bounding_cap_of_directions(w.data(), g.light.count);
 }
 
+// Kinks of a warp that picks a piece (fan triangle, sector) by xi_0 in proportion to `area`: the warp is
+// only piecewise smooth in xi_0 (the solid-angle fan is even discontinuous there: the arc of triangle k ends on
+// v_{k+1}, that of triangle k+1 starts from it), so the battery's finite-difference Jacobian must not straddle
+// the cumulative fractions sum_{i<=k} A_i / A_total. Computed from the long double view, as the reference warp.
+template <class It> std::vector<Real> cumulative_fractions(It first, It last) {
+  Real total = 0;
+  for (It i = first; i != last; ++i) total += Real(*i);
+  std::vector<Real> k;
+  Real sum = 0;
+  if (!(total > 0)) return k;
+  for (It i = first; i != last; ++i) {
+    sum += Real(*i);
+    if (Real(*i) > 0 && sum < total) k.push_back(sum / total);
+  }
+  return k;
+}
+template <class T, bool kBiased> std::vector<Real> projected_kinks(const PolygonLightGeometry<T>& g) {
+  const auto v = make_polygon_projected_view<T, kBiased>(g);
+  std::vector<T> a;
+  for (int k = 0; k < v.sector_count; ++k) a.push_back(v.sectors[k].area);
+  return cumulative_fractions(a.begin(), a.end());
+}
+template <class T, class View> std::vector<Real> fan_kinks(const View& v) {
+  return v.valid() ? cumulative_fractions(v.area.begin() + 1, v.area.begin() + std::max(1, v.fan.count - 1))
+                   : std::vector<Real>{};
+}
+
 template <class T> struct ProjectedKernel {
   // The density with the per-light precomputation done once (the battery's quadrature calls it millions of times).
   static std::function<Real(const Vec3L&)> cached_pdf(const PolygonLightGeometry<T>& g) {
@@ -40,6 +68,7 @@ template <class T> struct ProjectedKernel {
     return v.valid() ? cap_of_projected(v) : cap_of_polygon(g);
   }
   static T normaliser(const Geometry& g) { return make_polygon_projected_view<T>(g).projected_solid_angle; }
+  static std::vector<Real> kinks_u0(const Geometry& g) { return projected_kinks<T, false>(g); }
 };
 
 template <class T> struct BiasedKernel {
@@ -56,6 +85,7 @@ template <class T> struct BiasedKernel {
   static T pdf(const Geometry& g, const Vec3<T>& w) { return pdf_polygon_projected_solid_angle_biased(g, w); }
   static Cap<T> bounding_cap(const Geometry& g) { return ProjectedKernel<T>::bounding_cap(g); }
   static T normaliser(const Geometry& g) { return make_polygon_projected_view<T, true>(g).projected_solid_angle; }
+  static std::vector<Real> kinks_u0(const Geometry& g) { return projected_kinks<T, true>(g); }
 };
 
 template <class T, bool kClipped> struct SolidAngleKernel {
@@ -75,6 +105,7 @@ template <class T, bool kClipped> struct SolidAngleKernel {
     return f.valid() ? cap_of_fan(f) : cap_of_polygon(g);
   }
   static T normaliser(const Geometry& g) { return make_polygon_solid_angle_view(g, kClipped).solid_angle; }
+  static std::vector<Real> kinks_u0(const Geometry& g) { return fan_kinks<T>(make_polygon_solid_angle_view(g, kClipped)); }
 };
 template <class T> using SolidAngleUnclipped = SolidAngleKernel<T, false>;
 template <class T> using SolidAngleClipped = SolidAngleKernel<T, true>;
@@ -93,6 +124,7 @@ template <class T> struct ArvoKernel {
   static T pdf(const Geometry& g, const Vec3<T>& w) { return pdf_arvo_triangle_fan(g, w); }
   static Cap<T> bounding_cap(const Geometry& g) { return SolidAngleKernel<T, false>::bounding_cap(g); }
   static T normaliser(const Geometry& g) { return make_arvo_fan_view(g).solid_angle; }
+  static std::vector<Real> kinks_u0(const Geometry& g) { return fan_kinks<T>(make_arvo_fan_view(g)); }
 };
 
 template <class T> struct TurkKernel {
@@ -109,6 +141,7 @@ template <class T> struct TurkKernel {
   static T pdf(const Geometry& g, const Vec3<T>& w) { return pdf_turk_area(g, w); }
   static Cap<T> bounding_cap(const Geometry& g) { return SolidAngleKernel<T, false>::bounding_cap(g); }
   static T normaliser(const Geometry& g) { return make_turk_area_view(g).total_area; }
+  static std::vector<Real> kinks_u0(const Geometry& g) { return fan_kinks<T>(make_turk_area_view(g)); }
 };
 
 template <class T> struct UrenaKernel {
@@ -125,6 +158,7 @@ template <class T> struct UrenaKernel {
   static T pdf(const Geometry& g, const Vec3<T>& w) { return pdf_spherical_rectangle(g, w); }
   static Cap<T> bounding_cap(const Geometry& g) { return SolidAngleKernel<T, false>::bounding_cap(g); }
   static T normaliser(const Geometry& g) { return make_spherical_rectangle_view(g).solid_angle; }
+  static std::vector<Real> kinks_u0(const Geometry&) { return {}; }  // one smooth warp (Urena et al. 2013 Sec. 4)
 };
 
 // What each kernel's normaliser is and its independent reference.
@@ -190,6 +224,7 @@ void add_case(Registry& r, const char* kernel, const PolygonConfig& c, Measure m
     SamplerUnderTest s = bind_kernel<K<T>, K<Real>>(kernel, c.name, c.g.template cast<T>(), c.g);
     s.pdf = K<T>::cached_pdf(c.g.template cast<T>());  // same density as K::pdf, without rebuilding the view
     s.expect_no_sample = !K<Real>::sample(c.g, Vec2<Real>(0.5L, 0.5L)).valid();
+    s.kinks_u0 = K<Real>::kinks_u0(c.g);
     if (s.expect_no_sample || measure == Measure::kNone) return s;
     Normalization n;
     n.kernel = [g = c.g.template cast<T>()] { return Real(K<T>::normaliser(g)); };
