@@ -405,7 +405,12 @@ TestResult kolmogorov_smirnov(const SamplerUnderTest& s, std::string name, std::
   return r;
 }
 
-void ks_tests(const SamplerUnderTest& s, const BatteryOptions& o, Draws& d, std::vector<TestResult>& out) {
+// The two marginal CDFs of the KS tests, known at nodes (seed-independent: computed once per sampler).
+struct KsCdfs {
+  std::vector<Real> xr, Fr, xa, Fa;
+};
+
+KsCdfs ks_cdfs(const SamplerUnderTest& s, const BatteryOptions& o) {
   const int M = o.ks_cdf_nodes;
   const Cap<Real>& cap = s.bounding_cap;
   // Radial marginal: nodes clustered at both ends (Chebyshev-Lobatto), where the densities of visible-area
@@ -430,8 +435,12 @@ void ks_tests(const SamplerUnderTest& s, const BatteryOptions& o, Draws& d, std:
   std::vector<Real> Fr(M + 1, 0), Fa(M + 1, 0);
   for (int k = 0; k < M; ++k) Fr[k + 1] = Fr[k] + dr[k], Fa[k + 1] = Fa[k] + da[k];
   if (o.progress) o.progress("ks", 0.5);
-  out.push_back(kolmogorov_smirnov(s, "ks-radial", std::move(d.t), xr, Fr));
-  out.push_back(kolmogorov_smirnov(s, "ks-azimuth", std::move(d.phi), xa, Fa));
+  return {std::move(xr), std::move(Fr), std::move(xa), std::move(Fa)};
+}
+
+void ks_tests(const SamplerUnderTest& s, const KsCdfs& c, Draws& d, std::vector<TestResult>& out) {
+  out.push_back(kolmogorov_smirnov(s, "ks-radial", std::move(d.t), c.xr, c.Fr));
+  out.push_back(kolmogorov_smirnov(s, "ks-azimuth", std::move(d.phi), c.xa, c.Fa));
 }
 
 TestResult pdf_integral(const SamplerUnderTest& s, const BatteryOptions& o, const std::vector<Real>& mass) {
@@ -567,10 +576,9 @@ std::string json_number(double v) {
   return buf;
 }
 
-}  // namespace
 
-std::vector<TestResult> run_battery(const SamplerUnderTest& s, const BatteryOptions& options) {
-  std::vector<TestResult> out;
+// Validates the options and the sampler; returns the options the battery really uses.
+BatteryOptions checked_options(const SamplerUnderTest& s, const BatteryOptions& options) {
   // A float pdf carries rounding noise of a few FLT_EPSILON relative; asking the quadrature for 1e-8 of it only
   // spends every line's panel budget on noise (measured: sphere-visible-area float near took > 10 min of
   // quadrature instead of seconds). The tolerance is raised to 16 epsilon of the sampler's scalar type, 1.9e-6
@@ -583,26 +591,70 @@ std::vector<TestResult> run_battery(const SamplerUnderTest& s, const BatteryOpti
     throw std::invalid_argument("SamplerUnderTest needs a bounding cap with 0 < 1 - cos(half-angle) <= 2");
   if (o.samples < 1000 || o.radial_bins < 1 || o.azimuth_bins < 1 || o.ks_cdf_nodes < 16)
     throw std::invalid_argument("battery options out of range (samples >= 1000, bins >= 1, ks_cdf_nodes >= 16)");
-  if (s.expect_no_sample) {
-    out.push_back(no_sample(s, o));
-    return out;
-  }
-  Draws d = draw(s, o);
+  return o;
+}
+
+// Everything of a battery run that does not depend on the seed: the bins' masses and the KS marginals by
+// quadrature, and the deterministic tests (pdf integral, pdf consistency, normalisations).
+struct Prepared {
+  std::vector<Real> mass;
+  KsCdfs ks;
+  std::vector<TestResult> deterministic;
+};
+
+Prepared prepare(const SamplerUnderTest& s, const BatteryOptions& o) {
+  Prepared p;
   if (o.progress) o.progress("quadrature", 0);
-  const std::vector<Real> mass = bin_masses(s, o);
-  out.push_back(chi_square(s, o, d, mass));
-  ks_tests(s, o, d, out);
-  out.push_back(pdf_integral(s, o, mass));
-  out.push_back(pdf_consistency(s, o));
+  p.mass = bin_masses(s, o);
+  p.ks = ks_cdfs(s, o);
+  p.deterministic.push_back(pdf_integral(s, o, p.mass));
+  p.deterministic.push_back(pdf_consistency(s, o));
   for (const Normalization& nz : s.normalizations) {
     TestResult r = make_result(s, "normalization:" + nz.what);
     const Real k = nz.kernel();
     r.statistic = double(std::abs(k / nz.reference - 1));
     r.passed = r.statistic <= double(s.tolerance);
     r.detail = "kernel " + fmt(double(k), 17) + ", reference " + fmt(double(nz.reference), 17);
-    out.push_back(r);
+    p.deterministic.push_back(r);
   }
+  return p;
+}
+
+// The seed's draws and the statistical tests on them, then the deterministic results: the order of run_battery.
+std::vector<TestResult> run_seed(const SamplerUnderTest& s, const BatteryOptions& o, const Prepared& p) {
+  std::vector<TestResult> out;
+  Draws d = draw(s, o);
+  out.push_back(chi_square(s, o, d, p.mass));
+  ks_tests(s, p.ks, d, out);
+  out.insert(out.end(), p.deterministic.begin(), p.deterministic.end());
   return out;
+}
+
+}  // namespace
+
+std::vector<TestResult> run_battery(const SamplerUnderTest& s, const BatteryOptions& options) {
+  return run_battery_seeds(s, options, {options.seed}).front();
+}
+
+std::vector<std::vector<TestResult>> run_battery_seeds(const SamplerUnderTest& s, const BatteryOptions& options,
+                                                       const std::vector<std::uint64_t>& seeds) {
+  const BatteryOptions o = checked_options(s, options);
+  std::vector<std::vector<TestResult>> runs;
+  if (s.expect_no_sample) {
+    for (std::uint64_t seed : seeds) {
+      BatteryOptions os = o;
+      os.seed = seed;
+      runs.push_back({no_sample(s, os)});
+    }
+    return runs;
+  }
+  const Prepared p = prepare(s, o);
+  for (std::uint64_t seed : seeds) {
+    BatteryOptions os = o;
+    os.seed = seed;
+    runs.push_back(run_seed(s, os, p));
+  }
+  return runs;
 }
 
 std::size_t apply_correction(std::vector<TestResult>& results, double alpha, Correction c) {

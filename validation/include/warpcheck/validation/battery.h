@@ -60,6 +60,12 @@ struct BatteryOptions {
 // Runs every test of the battery on one sampler. Statistical results come back with passed == false until
 // apply_correction judges them.
 std::vector<TestResult> run_battery(const SamplerUnderTest& s, const BatteryOptions& options);
+// The same battery once per seed (options.seed is ignored), with the seed-independent work done once: the
+// quadrature of the chi-square bins and of the KS marginals, and the deterministic tests (their results are
+// repeated in every run). run_battery_seeds(s, o, {o.seed})[0] is run_battery(s, o). For calibration and for
+// users who want several independent runs of an expensive pdf.
+std::vector<std::vector<TestResult>> run_battery_seeds(const SamplerUnderTest& s, const BatteryOptions& options,
+                                                       const std::vector<std::uint64_t>& seeds);
 
 // Judges every statistical result at family-wise level alpha across all of them (Sidak: each p <= 1 - (1 -
 // alpha)^(1/m); Holm: step-down). Returns the number m of statistical tests.
