@@ -301,7 +301,8 @@ template <class T> L kappa_of(const Vec3<T>* v, int n, const Vec3<T>& x) {
 // (The polygon's own edges: for a sliver accepted by check_polygon but reflex at the rounding level this is
 // not the cone of its convex hull; a hull in the noise plane of such a sliver is not meaningful either, see
 // fuzz/README.md, "Known limits".)
-template <class T> L polygon_cone_margin(const PolygonLight<T>& p, const Vec3<T>& x, const Vec3<T>& w) {
+// P: the vertices' type (T, or L for a displaced light computed in long double); T: the kernel's precision.
+template <class P, class T = P> L polygon_cone_margin(const PolygonLight<P>& p, const Vec3<P>& x, const Vec3<P>& w) {
   const int n = p.count;
   const Vec3<L> xl = x.template cast<L>(), wl = w.template cast<L>().normalized();
   Vec3<L> area = Vec3<L>::Zero();

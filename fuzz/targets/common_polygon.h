@@ -31,11 +31,30 @@ template <class T> bool polygon_input_finite(const PolygonLightGeometry<T>& g) {
 // The conditioning kappa of the header comment; for kernels clipped to the horizon also the clip points'
 // (|p| + |q| + |V_j|_inf + |V_{j+1}|_inf + |x|_inf) / dist(x, line of the edge) for every edge that crosses
 // the horizon: the clip point lies on that line, so its direction is known to eps_T times that ratio.
+//
+// The vertex term of common.h bounds the angular error of a boundary point P by delta / |P - x| with |P - x| >= the
+// distance to the nearest vertex; but a boundary point may lie closer to x than every vertex: on an edge that
+// passes near x. The same argument (a point of the moved polygon outside the exact cone lies within delta of the
+// exact boundary) gives delta / dist(x, boundary), so every edge contributes
+// (max(|V_j|_inf, |V_{j+1}|_inf) + |x|_inf + 16 min_T) / dist(x, segment V_j V_{j+1}) (found by
+// fuzz_polygon_projected_double: an edge passing 4e-14 from x, whose great circle through x the coordinates
+// do not determine, issue 7). The horizon arcs of a clipped polygon lie on the exactly known horizon.
 template <class T> L polygon_kappa(const PolygonLightGeometry<T>& g, bool clipped) {
   const int n = g.light.count;
   L k = kappa_of<T>(g.light.vertices.data(), n, g.shading.position);
-  if (!clipped) return k;
   const Vec3<L> x = g.shading.position.template cast<L>(), nl = g.shading.normal.template cast<L>();
+  for (int j = 0; j < n; ++j) {
+    const Vec3<L> vj = g.light.vertices[j].template cast<L>(), vj1 = g.light.vertices[(j + 1) % n].template cast<L>();
+    const Vec3<L> p = vj - x, e = vj1 - vj;
+    const L ee = e.squaredNorm();
+    if (!(ee > 0)) continue;  // a repeated vertex: covered by the vertex term
+    const L t = -p.dot(e) / ee;
+    const L seg_dist = t <= 0 ? p.norm() : (t >= 1 ? (vj1 - x).norm() : kahan_cross<L>(p, e).norm() / std::sqrt(ee));
+    const L mag = std::max(vj.cwiseAbs().maxCoeff(), vj1.cwiseAbs().maxCoeff()) + x.cwiseAbs().maxCoeff() +
+                  kSubnormalUlps * L(std::numeric_limits<T>::min());
+    k = std::max(k, seg_dist > 0 ? mag / seg_dist : std::numeric_limits<L>::infinity());
+  }
+  if (!clipped) return k;
   for (int j = 0; j < n; ++j) {
     const Vec3<L> vj = g.light.vertices[j].template cast<L>(), vj1 = g.light.vertices[(j + 1) % n].template cast<L>();
     const Vec3<L> p = vj - x, q = vj1 - x, e = vj1 - vj;
@@ -47,11 +66,107 @@ template <class T> L polygon_kappa(const PolygonLightGeometry<T>& g, bool clippe
   return k;
 }
 
-// Signed angular margin of w inside the light (clipped: also above the shading horizon).
-template <class T> L polygon_margin(const PolygonLightGeometry<T>& g, const Vec3<T>& w, bool clipped) {
-  L m = polygon_cone_margin(g.light, g.shading.position, w);
-  if (clipped) m = std::min(m, g.shading.normal.template cast<L>().normalized().dot(w.template cast<L>().normalized()));
+// The light with every vertex dropped that lies within delta / 2 of its predecessor, delta = kTolUlps eps_T
+// (max_k |V_k|_inf + |x|_inf + 16 min_T) being the vertex displacement that the tolerance accepts (common.h).
+// An edge that short has a direction the coordinates do not determine: the polygon can be reflex at it (an
+// edge of subnormal length pointing out of the light's plane) and its great circle then cuts through the light.
+// The merged polygon is one of the accepted displacements of the light (found by
+// fuzz_polygon_solid_angle_double: edges of length 5e-324, 9e-308 and 3e-15, issue 7).
+template <class T> PolygonLight<T> merge_short_edges(const PolygonLight<T>& p, const Vec3<T>& x) {
+  const int n = p.count;
+  L mag = 0;
+  for (int i = 0; i < n; ++i) mag = std::max(mag, L(p.vertices[i].template cast<L>().cwiseAbs().maxCoeff()));
+  const L delta = L(kTolUlps) * eps<T>() *
+                  (mag + L(x.template cast<L>().cwiseAbs().maxCoeff()) + kSubnormalUlps * L(std::numeric_limits<T>::min()));
+  PolygonLight<T> m;
+  for (int i = 0; i < n; ++i) {
+    const Vec3<L> vi = p.vertices[i].template cast<L>();
+    if (m.count > 0 && (vi - m.vertices[m.count - 1].template cast<L>()).norm() <= delta / 2) continue;
+    m.vertices[m.count++] = p.vertices[i];
+  }
+  while (m.count > 1 && (m.vertices[m.count - 1].template cast<L>() - m.vertices[0].template cast<L>()).norm() <= delta / 2)
+    --m.count;
   return m;
+}
+
+// Angular distance of the direction w from the arc of directions from x to the segment a b.
+template <class T> L arc_distance(const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& x, const Vec3<T>& w) {
+  const Vec3<L> xl = x.template cast<L>(), wl = w.template cast<L>().normalized();
+  const Vec3<L> ua = (a.template cast<L>() - xl).normalized(), ub = (b.template cast<L>() - xl).normalized();
+  auto angle = [](const Vec3<L>& p, const Vec3<L>& q) { return std::atan2(p.cross(q).norm(), p.dot(q)); };
+  L d = std::min(angle(wl, ua), angle(wl, ub));
+  const Vec3<L> nab = ua.cross(ub);
+  const L nn = nab.norm();
+  if (nn > 0 && ua.cross(wl).dot(nab) >= 0 && wl.cross(ub).dot(nab) >= 0) d = std::min(d, std::abs(std::asin(std::clamp(nab.dot(wl) / nn, L(-1), L(1)))));
+  return d;
+}
+
+// Signed angular margins of w inside the light (clipped: also above the shading horizon): `inner` against the
+// light as given, `outer` the larger of that and the margin against merge_short_edges(light). A sample must lie
+// inside some accepted displacement of the light (outer >= -tol); a density of 0 needs w near the boundary of
+// some accepted displacement (inner <= tol).
+struct PolygonMargins {
+  L inner, outer;
+};
+template <class T> PolygonMargins polygon_margins(const PolygonLightGeometry<T>& g, const Vec3<T>& w, bool clipped) {
+  L m = polygon_cone_margin(g.light, g.shading.position, w);
+  const PolygonLight<T> merged = merge_short_edges(g.light, g.shading.position);
+  L mm = m;
+  if (merged.count >= 3 && merged.count < g.light.count) mm = polygon_cone_margin(merged, g.shading.position, w);
+  // Merged down to a segment or a point: the light is within delta of it, so the accepted displacements' cones
+  // are within the tolerance of its arc (a polygon of width 6 and length 1e30: a sliver).
+  if (merged.count == 1 || merged.count == 2) mm = -arc_distance(merged.vertices[0], merged.vertices[merged.count - 1], g.shading.position, w);
+  // Other accepted displacements: a light within delta / 2 of a segment (a sliver: its width, the largest
+  // distance of a vertex from the line through its two farthest vertices, is at most delta / 2) is measured
+  // against that segment's arc; a light within delta / 2 of its plane against its vertices moved onto the
+  // plane (long double). A light non-planar below its coordinates' rounding, seen from x much closer to its
+  // plane than its shortest edge is long, is reflex at that edge (found by fuzz_polygon_projected_double: x
+  // 1.9e-26 from a light of size 1.5e-15, an edge 2.4e-26 long, off-plane residues 5e-32, issue 7).
+  {
+    const int n = g.light.count;
+    const Vec3<L> xl = g.shading.position.template cast<L>();
+    L mag = 0;
+    for (int i = 0; i < n; ++i) mag = std::max(mag, L(g.light.vertices[i].template cast<L>().cwiseAbs().maxCoeff()));
+    const L delta = L(kTolUlps) * eps<T>() * (mag + xl.cwiseAbs().maxCoeff() + kSubnormalUlps * L(std::numeric_limits<T>::min()));
+    int ia = 0, ib = 0;
+    L diam = 0;
+    for (int i = 0; i < n; ++i)
+      for (int j = i + 1; j < n; ++j) {
+        const L d = (g.light.vertices[i].template cast<L>() - g.light.vertices[j].template cast<L>()).norm();
+        if (d > diam) diam = d, ia = i, ib = j;
+      }
+    if (diam > 0) {
+      const Vec3<L> a = g.light.vertices[ia].template cast<L>(), e = g.light.vertices[ib].template cast<L>() - a;
+      L width = 0;
+      for (int i = 0; i < n; ++i) width = std::max(width, kahan_cross<L>(Vec3<L>(g.light.vertices[i].template cast<L>() - a), e).norm() / diam);
+      if (width <= delta / 2) mm = std::max(mm, -arc_distance(g.light.vertices[ia], g.light.vertices[ib], g.shading.position, w));
+    }
+    Vec3<L> area = Vec3<L>::Zero(), c = Vec3<L>::Zero();
+    const Vec3<L> v0 = g.light.vertices[0].template cast<L>();
+    for (int i = 1; i + 1 < n; ++i)
+      area += kahan_cross<L>(Vec3<L>(g.light.vertices[i].template cast<L>() - v0), Vec3<L>(g.light.vertices[i + 1].template cast<L>() - v0));
+    for (int i = 0; i < n; ++i) c += g.light.vertices[i].template cast<L>() / L(n);
+    const L an = area.norm();
+    if (an > 0 && n >= 3) {
+      const Vec3<L> nh = area / an;
+      PolygonLight<L> flat;
+      flat.count = n;
+      L off = 0;
+      for (int i = 0; i < n; ++i) {
+        const Vec3<L> vi = g.light.vertices[i].template cast<L>();
+        const L d = nh.dot(Vec3<L>(vi - c));
+        off = std::max(off, std::abs(d));
+        flat.vertices[i] = vi - d * nh;
+      }
+      if (off > 0 && off <= delta / 2)
+        mm = std::max(mm, polygon_cone_margin<L, T>(flat, xl, Vec3<L>(w.template cast<L>())));
+    }
+  }
+  if (clipped) {
+    const L h = g.shading.normal.template cast<L>().normalized().dot(w.template cast<L>().normalized());
+    m = std::min(m, h), mm = std::min(mm, h);
+  }
+  return {std::min(m, mm), std::max(m, mm)};
 }
 
 template <class T, class Sample, class Pdf>
@@ -69,9 +184,9 @@ void check_polygon_kernel(FuzzedDataProvider& in, const PolygonLightGeometry<T>&
     if (!finite_input) WARPCHECK_FUZZ_REQUIRE(!s.valid(), "a sample from non-finite input", geo);
     if (!s.valid()) continue;
     WARPCHECK_FUZZ_REQUIRE(valid_polygon, "a sample from a polygon that check_polygon rejects", geo);
-    const L margin = polygon_margin(g, s.direction, clipped);
-    WARPCHECK_FUZZ_REQUIRE(margin >= -tol, "direction outside the polygon",
-                           geo << "direction " << show(s.direction) << " margin " << margin << " tol " << tol << "\n");
+    const PolygonMargins margins = polygon_margins(g, s.direction, clipped);
+    WARPCHECK_FUZZ_REQUIRE(margins.outer >= -tol, "direction outside the polygon",
+                           geo << "direction " << show(s.direction) << " margin " << margins.outer << " tol " << tol << "\n");
     L rel = 8 * eps<T>();
     if (density == PolygonDensity::kCosine || density == PolygonDensity::kArea) {
       // The cosine both densities are computed from (shading normal resp. light normal, in T).
@@ -79,7 +194,7 @@ void check_polygon_kernel(FuzzedDataProvider& in, const PolygonLightGeometry<T>&
       const L c = std::abs(axis.template cast<L>().normalized().dot(s.direction.template cast<L>()));
       rel = c > 0 ? rel * (density == PolygonDensity::kArea ? 3 : 1) / c : L(1);
     }
-    check_pdf_consistency<T>(s.pdf, pdf(s.direction), rel, margin, tol, geo);
+    check_pdf_consistency<T>(s.pdf, pdf(s.direction), rel, margins.inner, tol, geo);
   }
   // The density at an arbitrary unit direction: finite, >= 0, zero for invalid geometry and well outside.
   const Vec3<T> w = safe_normalized(in.ConsumeBool() ? vec3<T>(in)
@@ -90,7 +205,7 @@ void check_polygon_kernel(FuzzedDataProvider& in, const PolygonLightGeometry<T>&
   if (!finite_input || !valid_polygon) {
     WARPCHECK_FUZZ_REQUIRE(p == T(0), "pdf > 0 for invalid geometry", geo << "pdf " << p << "\n");
   } else if (!w.isZero()) {
-    const L margin = polygon_margin(g, w, clipped);
+    const L margin = polygon_margins(g, w, clipped).outer;
     if (margin < -tol)
       WARPCHECK_FUZZ_REQUIRE(p == T(0), "pdf > 0 outside the polygon",
                              geo << "pdf " << p << " margin " << margin << " tol " << tol << "\n");

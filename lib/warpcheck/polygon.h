@@ -27,6 +27,8 @@ namespace warpcheck {
 inline constexpr int kMaxPolygonVertices = 8;
 // Clipping a convex polygon to a half-space adds at most one vertex.
 inline constexpr int kMaxClippedVertices = kMaxPolygonVertices + 1;
+// The solid-angle fan of a clipped polygon may add one more: the midpoint of a horizon edge (polygon_solid_angle.h).
+inline constexpr int kMaxFanVertices = kMaxClippedVertices + 1;
 
 template <class T> struct PolygonLight {
   std::array<Vec3<T>, kMaxPolygonVertices> vertices{};
@@ -232,7 +234,7 @@ template <class T> PolygonView<T> make_polygon_view(const PolygonLightGeometry<T
 // keeping the best; the radius is measured by chord length so that tiny caps keep their precision. A relative
 // slack of 64 eps covers the rounding of the vertices' normalisation.
 template <class T> Cap<T> bounding_cap_of_directions(const Vec3<T>* dirs, int n) {
-  std::array<Vec3<T>, kMaxClippedVertices> u;
+  std::array<Vec3<T>, kMaxFanVertices> u;
   Vec3<T> mean = Vec3<T>::Zero();
   for (int i = 0; i < n; ++i) mean += (u[i] = safe_normalized(dirs[i]));
   auto radius2 = [&](const Vec3<T>& axis, int* far) {

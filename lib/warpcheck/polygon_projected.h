@@ -99,8 +99,13 @@ template <class T> void edge_boundary_point(const EdgeEllipse<T>& e, const Vec3<
                                             const Vec2<T>& w, T* r2, T* z2) {
   const T ca = kahan_cross2(w, Vec2<T>(a.x(), a.y())), cb = kahan_cross2(w, Vec2<T>(b.x(), b.y()));
   const T den = ca - cb;
-  if (a != b && den != T(0) && std::isfinite(den)) {
-    const T t = std::clamp(ca / den, T(0), T(1));
+  if (a != b && std::isfinite(den)) {
+    // den = 0: the segment's xy projection is parallel to w up to rounding. Inside a sector that means a radial
+    // edge (its great circle through the zenith, n_z = 0): all its points have azimuth w and each one is a
+    // boundary point, while Eq. 3's radius along the degenerate ellipse's diameter is 0 / 0 rounding noise
+    // (found by fuzz_polygon_projected_double: u_0 = 0 picked a zero-width sector of area 8e-21 next to such an
+    // edge, sample 0.75 rad outside an ordinary triangle, issue 7). We take its midpoint.
+    const T t = den != T(0) ? std::clamp(ca / den, T(0), T(1)) : T(0.5);
     const Vec3<T> p = a + t * (b - a);
     const T m = p.cwiseAbs().maxCoeff();
     if (m > T(0) && std::isfinite(m)) {
@@ -271,6 +276,13 @@ template <class T> struct PolygonProjectedView {
   bool flip_y = false;           // y flipped so that the vertex order winds positively (Sec. 3.1)
   LocalPolygon<T> clipped;       // in the (flipped) shading frame, clipped to z >= 0
   std::array<Vec3<T>, kMaxClippedVertices> edge_normals{};  // n_j = v_j x v_{j+1} (Kahan), not normalised
+  // The density's cone test (world space): the light's own edge planes (V_j - x) x (V_{j+1} - V_j), oriented
+  // inwards, and the horizon. Not the n_j: those come from rounded V - x, and for an edge shorter than that
+  // rounding (1e-15 at coordinates ~20) their direction is noise, so pdf() rejected directions 1.8e-9 rad
+  // inside the light (found by fuzz_polygon_projected_double, issue 7); V_{j+1} - V_j of nearby vertices is
+  // exact (Sterbenz). The clipped edges lie on the same planes (clip_to_upper_hemisphere).
+  std::array<Vec3<T>, kMaxPolygonVertices + 1> inward{};
+  int planes = 0;
   bool central = true;
   int sector_count = 0;
   std::array<ProjectedSector<T>, kMaxClippedVertices> sectors{};
@@ -294,6 +306,15 @@ template <class T, bool kBiased = false> PolygonProjectedView<T> make_polygon_pr
   if (!pv.valid()) return v.reason = pv.reason, v;
   v.frame = pv.frame;
   v.flip_y = pv.plane_distance < T(0);
+  {
+    const int n = g.light.count;
+    const T orient = v.flip_y ? T(-1) : T(1);
+    for (int j = 0; j < n; ++j)
+      v.inward[j] = orient * kahan_cross(Vec3<T>(g.light.vertices[j] - g.shading.position),
+                                         Vec3<T>(g.light.vertices[(j + 1) % n] - g.light.vertices[j]));
+    v.inward[n] = pv.normal;
+    v.planes = n + 1;
+  }
   LocalPolygon<T> local = pv.local;
   if (v.flip_y)
     for (int i = 0; i < local.count; ++i) local.v[i].y() = -local.v[i].y();
@@ -376,8 +397,8 @@ template <class T> T pdf_polygon_projected_solid_angle(const PolygonProjectedVie
   if (!v.valid() || !all_finite(w)) return T(0);
   const Vec3<T> l = v.to_local(w);
   if (!(l.z() > T(0))) return T(0);
-  for (int j = 0; j < v.clipped.count; ++j)
-    if (v.edge_normals[j].dot(l) < T(0)) return T(0);
+  for (int j = 0; j < v.planes; ++j)
+    if (v.inward[j].dot(w) < T(0)) return T(0);
   const T len = w.norm();
   return len > T(0) ? l.z() / len / v.projected_solid_angle : T(0);
 }
@@ -406,7 +427,10 @@ DirectionSample<T> sample_polygon_projected_solid_angle(const PolygonProjectedVi
   Vec2<T> w;
   T ri2 = 0, zi2 = 1, ro2, zo2;
   if (!s.decentral) {
-    w = invert_central_sector(s, target);
+    // Kept in the sector: the biased variant's sector areas come from atan2_approx (Sec. 6.4), so its closed-form
+    // angle 2 A / |n_z| can overshoot s1 by the approximation's error (found by fuzz_polygon_projected_double:
+    // u_0 = 1 - ulp, sample 5.8e-6 rad outside, issue 7).
+    w = clamp_to_sector(s, invert_central_sector(s, target));
   } else {
     w = invert_decentral_sector<T, kBiased>(s, target, iterations);
     edge_boundary_point(s.inner, s.inner_a, s.inner_b, w, &ri2, &zi2);

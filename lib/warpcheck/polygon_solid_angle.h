@@ -19,9 +19,9 @@ namespace warpcheck {
 template <class T> struct PolygonFanView {
   NoSample reason = NoSample::kNone;
   int count = 0;
-  std::array<Vec3<T>, kMaxClippedVertices> p{};       // vertex - shading point
-  std::array<Vec3<T>, kMaxClippedVertices> e{};       // p_k - p_0, from the light's own vertices if unclipped
-  std::array<Vec3<T>, kMaxClippedVertices> u{};       // p_k / |p_k|
+  std::array<Vec3<T>, kMaxFanVertices> p{};           // vertex - shading point
+  std::array<Vec3<T>, kMaxFanVertices> e{};           // p_k - p_0, from the light's own vertices if unclipped
+  std::array<Vec3<T>, kMaxFanVertices> u{};           // p_k / |p_k|
   // The cone is {w : inward_j . w >= 0, j < planes}: unclipped, inward_j = p_j x p_{j+1}; clipped, the
   // light's own edge planes (from V_j - x) and the horizon, never planes through two clip points, whose
   // normal is undetermined when the clip points (nearly) coincide (found by fuzz_polygon_solid_angle_double:
@@ -64,17 +64,45 @@ template <class T> PolygonFanView<T> make_polygon_fan_view(const PolygonLightGeo
     bool strictly_above = false;
     for (int i = 0; i < c.count; ++i) strictly_above = strictly_above || c.v[i].z() > T(0);
     if (c.count < 3 || !strictly_above) return f.reason = NoSample::kBelowHorizon, f;
-    f.count = c.count;
-    for (int k = 0; k < c.count; ++k) f.p[k] = pv.frame.to_world(c.v[reverse ? (c.count - k) % c.count : k]);
-    for (int k = 0; k < c.count; ++k) f.e[k] = f.p[k] - f.p[0];
+    // A horizon edge (both ends at z = 0) wider than 90 degrees gets its midpoint as an extra vertex. Its ends
+    // are nearly antipodal when the light's plane passes close to x: the fan triangle holding them then has an
+    // edge whose great circle (and Eq. 13's area, 0 / 0) is rounding noise, although the edge lies on the
+    // horizon (found by fuzz_polygon_solid_angle_double: x 2.4e-10 off a rectangle, sample 2.3e-10 rad outside,
+    // issue 7). The midpoint is n x (u_b - u_a), turned towards the light's plane (every direction of the light
+    // has plane_normal . w of the sign of plane_distance): no cancellation. At most one such edge exists, the
+    // horizon part of a polygon in the upper hemisphere spanning at most 180 degrees.
+    std::array<Vec3<T>, kMaxFanVertices> q;
+    int nq = 0;
+    const Vec3<T> light_normal = pv.frame.to_local(pv.plane_normal);
+    for (int i = 0; i < c.count; ++i) {
+      const Vec3<T>&a = c.v[i], &b = c.v[(i + 1) % c.count];
+      q[nq++] = a;
+      if (a.z() != T(0) || b.z() != T(0) || nq + (c.count - 1 - i) >= kMaxFanVertices) continue;  // room for the rest
+      const Vec3<T> ua = safe_normalized(a), ub = safe_normalized(b);
+      if (!(ua.dot(ub) < T(0))) continue;
+      Vec3<T> mid = safe_normalized(Vec3<T>(ua.y() - ub.y(), ub.x() - ua.x(), T(0)));
+      if (light_normal.dot(mid) * pv.plane_distance < T(0)) mid = -mid;
+      if (!mid.isZero()) q[nq++] = mid * ((a.norm() + b.norm()) / T(2));
+    }
+    f.count = nq;
+    for (int k = 0; k < nq; ++k) f.p[k] = pv.frame.to_world(q[reverse ? (nq - k) % nq : k]);
+    for (int k = 0; k < nq; ++k) f.e[k] = f.p[k] - f.p[0];
   }
   for (int k = 0; k < f.count; ++k) {
     f.u[k] = safe_normalized(f.p[k]);
     if (f.u[k].isZero()) return f.reason = NoSample::kNonFinite, f;
   }
   if (!clipped) {
+    // p_j x p_{j+1} = p_j x (V_b - V_a): the edge from the light's own vertices, not from p_{j+1} - p_j. For an
+    // edge shorter than the rounding of V - x (3e-15 at coordinates ~30) the difference of the p's has a
+    // direction of rounding noise, and its plane rejected directions 5e-8 rad inside the light (found by
+    // fuzz_polygon_solid_angle_double, issue 7); V_b - V_a of nearby vertices is exact (Sterbenz).
+    const int m = g.light.count;
     f.planes = f.count;
-    for (int j = 0; j < f.count; ++j) f.inward[j] = kahan_cross(f.p[j], f.p[(j + 1) % f.count]);
+    for (int j = 0; j < f.count; ++j) {
+      const int a = reverse ? (m - j) % m : j, b = reverse ? (m - j - 1 + m) % m : (j + 1) % m;
+      f.inward[j] = kahan_cross(f.p[j], Vec3<T>(g.light.vertices[b] - g.light.vertices[a]));
+    }
   } else {
     const int m = g.light.count;
     const T orient = reverse ? T(-1) : T(1);
@@ -97,7 +125,7 @@ template <class T> bool in_fan_cone(const PolygonFanView<T>& f, const Vec3<T>& w
 
 template <class T> struct PolygonSolidAngleView {
   PolygonFanView<T> fan;
-  std::array<T, kMaxClippedVertices> g0{}, area{};  // per fan triangle (0, k, k+1), stored at index k
+  std::array<T, kMaxFanVertices> g0{}, area{};  // per fan triangle (0, k, k+1), stored at index k
   T solid_angle = 0;
   NoSample reason = NoSample::kNone;
   bool valid() const { return reason == NoSample::kNone; }
@@ -127,7 +155,7 @@ template <class T> PolygonSolidAngleView<T> make_polygon_solid_angle_view(const 
 }
 
 // Picks the fan triangle for xi_0 in proportion to `area`, returning the remaining area in it.
-template <class T> int pick_fan_triangle(const std::array<T, kMaxClippedVertices>& area, int count, T target,
+template <class T, std::size_t N> int pick_fan_triangle(const std::array<T, N>& area, int count, T target,
                                          T* remaining) {
   int k = -1;
   for (int i = 1; i + 1 < count; ++i) {
@@ -239,7 +267,10 @@ template <class T> DirectionSample<T> sample_arvo_triangle_fan(const ArvoFanView
   const T alpha = v.alpha[k];
   const T s = std::sin(ahat - alpha), t = std::cos(ahat - alpha);
   const T uu = t - std::cos(alpha), vv = s + std::sin(alpha) * A.dot(B);
-  const T q = std::clamp(((vv * t - uu * s) * std::cos(alpha) - vv) / ((vv * s + uu * t) * std::sin(alpha)), T(-1), T(1));
+  // Arvo 1995's q; a zero denominator (found by the sanitizer replay of fuzz_polygon_arvo_*: float-divide-by-zero)
+  // takes the limit of the clamped quotient, +-1 by the numerator's sign, without dividing.
+  const T q_num = (vv * t - uu * s) * std::cos(alpha) - vv, q_den = (vv * s + uu * t) * std::sin(alpha);
+  const T q = q_den != T(0) ? std::clamp(q_num / q_den, T(-1), T(1)) : (q_num < T(0) ? T(-1) : T(1));
   const Vec3<T> chat = q * A + std::sqrt(T(1) - q * q) * safe_normalized(Vec3<T>(C - C.dot(A) * A));
   const T z = T(1) - xi[1] * (T(1) - chat.dot(B));
   const Vec3<T> p = z * B + std::sqrt(std::max(T(0), T(1) - z * z)) * safe_normalized(Vec3<T>(chat - chat.dot(B) * B));
@@ -287,6 +318,7 @@ template <class T> TurkAreaView<T> make_turk_area_view(const PolygonLightGeometr
 // Per solid angle: dA = dist^2 / cos_light dw, dist = h / |N.w|, cos_light = |N.w|.
 template <class T> T turk_density(const TurkAreaView<T>& v, const Vec3<T>& w) {
   const T c = std::abs(v.fan.plane_normal.dot(w));
+  if (!(c > T(0))) return T(0);  // grazing the light's plane: no area seen (and no division by zero under UBSan)
   const T h = v.fan.plane_distance;
   const T hc = h / c;
   const T pdf = hc * hc / (c * v.total_area);
