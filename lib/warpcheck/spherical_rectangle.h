@@ -71,7 +71,11 @@ template <class T> SphericalRectangleView<T> make_spherical_rectangle_view(const
 template <class T> DirectionSample<T> sample_spherical_rectangle(const SphericalRectangleView<T>& v, const Vec2<T>& xi) {
   if (!v.valid()) return DirectionSample<T>::none(v.reason);
   const T au = xi[0] * v.solid_angle + v.k;
-  const T fu = (std::cos(au) * v.b0 - v.b1) / std::sin(au);
+  // sin(au) = 0 at the ends of the range: fu is +-infinite there (its limit; Urena et al. 2013 Sec. 4); written
+  // without the division, which the float-divide-by-zero sanitizer flags (fuzz_spherical_rectangle_* replay).
+  const T fu_num = std::cos(au) * v.b0 - v.b1, sin_au = std::sin(au);
+  const T fu = sin_au != T(0) ? fu_num / sin_au
+                               : std::copysign(std::numeric_limits<T>::infinity(), fu_num) * std::copysign(T(1), sin_au);
   T cu = (fu > T(0) ? T(1) : T(-1)) / std::sqrt(fu * fu + v.b0 * v.b0);
   cu = std::clamp(cu, T(-1), T(1));
   T xu = -(cu * v.z0) / std::sqrt(T(1) - cu * cu);

@@ -236,6 +236,10 @@ int validate_main(const std::vector<std::string>& a) {
   if (resume) {
     std::set<std::string> done;
     all = load_results_to_resume(json, opt.samples, opt.seed, done);
+    // Known limitations are the current registry's policy, not the interrupted run's: re-tag resumed results.
+    for (TestResult& r : all)
+      for (const Case* c : select_cases(reg, sel))
+        if (c->kernel == r.kernel && c->scalar == r.scalar && c->config == r.config) r.known_limitation = c->known_limitation;
     const std::size_t before = cases.size();
     std::erase_if(cases, [&](const Case* c) { return done.count(case_key(c->kernel, c->scalar, c->config)) > 0; });
     std::fprintf(stderr, "resuming %s: %zu cases done, %zu to run\n", json.c_str(), before - cases.size(),

@@ -62,9 +62,24 @@ const SphereConfig kConfigs[] = {
     {"below-horizon", "entirely below the horizon: no sample", geom(Vec3L(0, 0, 0), Vec3L(0, 0, 1), Vec3L(0, 1, -3), 1)},
 };
 
+// Why the float visible-area sampler fails (measured at 1e7 samples, seed 1: `warpcheck validate --kernel
+// sphere-visible-area --scalar float`): near: pdf-integral 3.1e-4, chi2 p = 0, pdf(direction) = 0 for some sampled
+// directions; far: pdf-integral 5.7e-4. Its density dist^2 / (A cos_light) has cos_light = sqrt(disc) / r with
+// disc = r^2 - |f - (f.w) w|^2, whose absolute rounding error is ~eps |f|^2 in float: within that band of the
+// silhouette the float pdf is wrong by 100% and the sampler can land outside it. The band carries mass
+// ~sqrt(eps |f|^2 / r^2) of a density ~1/sqrt(disc) (sqrt(FLT_EPSILON) = 3.5e-4): the measured errors. No
+// reformulation removes it in float (the silhouette is defined by that difference); a renderer that needs it
+// evaluates disc in double. Double and long double pass.
+const char* const kVisibleAreaFloat =
+    "float visible-area sampling: the density ~1/cos_light is wrong by O(1) within ~eps|f|^2 of the silhouette "
+    "(disc = r^2 - |f_perp|^2 cancels), a band of mass ~sqrt(FLT_EPSILON) = 3.5e-4; measured pdf-integral 3.1e-4 "
+    "(near) to 5.7e-4 (far) at 1e7 samples; see registry_sphere.cpp";
+
 template <template <class> class K, class T>
-void add_case(Registry& r, const char* kernel, const SphereConfig& c, Normalization (*norm)(const SphereConfig&)) {
+void add_case(Registry& r, const char* kernel, const SphereConfig& c, Normalization (*norm)(const SphereConfig&),
+              const char* known_limitation = "") {
   Case k;
+  k.known_limitation = make_sphere_view(c.g).valid() ? known_limitation : "";  // no-sample cases pass
   k.kernel = kernel;
   k.scalar = scalar_name<T>();
   k.config = c.name;
@@ -73,6 +88,13 @@ void add_case(Registry& r, const char* kernel, const SphereConfig& c, Normalizat
     SamplerUnderTest s = bind_kernel<K<T>, K<Real>>(kernel, c.name, cast<T>(c.g), c.g);
     s.expect_no_sample = !make_sphere_view(c.g).valid();
     if (!s.expect_no_sample) s.normalizations.push_back(norm(c));
+    if constexpr (std::is_same_v<T, float>) {
+      // Measured, not derived: at 1e7 samples (seed 1) the float solid-angle kernel's pdf integrates to 1 - 5.2e-6 on
+      // "tiny" (cap half-angle 2e-3 rad, 1 - cos = 2e-6, a few float ulps of 1); the others stay below 1e-6. The
+      // battery's quadrature itself runs at 16 FLT_EPSILON = 1.9e-6 for float samplers (battery.cpp).
+      s.tolerance = 1e-5L;
+      s.tolerance_note = "float: measured pdf-integral error up to 5.2e-6 (tiny cap, 1 - cos(theta_max) = 2e-6)";
+    }
     return s;
   };
   r.add(std::move(k));
@@ -111,7 +133,7 @@ void register_sphere_kernels(Registry& r) {
     add_case<SphereSolidAngle, float>(r, "sphere-solid-angle", c, solid_angle_norm<float>);
     add_case<SphereSolidAngle, double>(r, "sphere-solid-angle", c, solid_angle_norm<double>);
     add_case<SphereSolidAngle, Real>(r, "sphere-solid-angle", c, solid_angle_norm<Real>);
-    add_case<SphereVisibleArea, float>(r, "sphere-visible-area", c, visible_area_norm<float>);
+    add_case<SphereVisibleArea, float>(r, "sphere-visible-area", c, visible_area_norm<float>, kVisibleAreaFloat);
     add_case<SphereVisibleArea, double>(r, "sphere-visible-area", c, visible_area_norm<double>);
     add_case<SphereVisibleArea, Real>(r, "sphere-visible-area", c, visible_area_norm<Real>);
   }
