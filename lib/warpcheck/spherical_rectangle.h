@@ -76,12 +76,19 @@ template <class T> DirectionSample<T> sample_spherical_rectangle(const Spherical
   const T fu_num = std::cos(au) * v.b0 - v.b1, sin_au = std::sin(au);
   const T fu = sin_au != T(0) ? fu_num / sin_au
                                : std::copysign(std::numeric_limits<T>::infinity(), fu_num) * std::copysign(T(1), sin_au);
-  T cu = (fu > T(0) ? T(1) : T(-1)) / std::sqrt(fu * fu + v.b0 * v.b0);
+  // The same for the other quotients below: a zero denominator takes the clamped limit instead of dividing.
+  const T cu_den = std::sqrt(fu * fu + v.b0 * v.b0), cu_sign = fu > T(0) ? T(1) : T(-1);
+  T cu = cu_den > T(0) ? cu_sign / cu_den : cu_sign;
   cu = std::clamp(cu, T(-1), T(1));
-  T xu = -(cu * v.z0) / std::sqrt(T(1) - cu * cu);
+  const T xu_num = -(cu * v.z0), xu_den = std::sqrt(T(1) - cu * cu);
+  T xu = xu_den > T(0) ? xu_num / xu_den : (xu_num < T(0) ? v.x0 : v.x1);
   xu = std::clamp(xu, v.x0, v.x1);
   const T d = std::sqrt(xu * xu + v.z0 * v.z0);
-  const T h0 = v.y0 / std::sqrt(d * d + v.y0 * v.y0), h1 = v.y1 / std::sqrt(d * d + v.y1 * v.y1);
+  auto sine_of = [d](T y) {  // y / sqrt(d^2 + y^2), 0 when both vanish
+    const T r = std::sqrt(d * d + y * y);
+    return r > T(0) ? y / r : T(0);
+  };
+  const T h0 = sine_of(v.y0), h1 = sine_of(v.y1);
   const T hv = h0 + xi[1] * (h1 - h0), hv2 = hv * hv;
   const T yv = hv2 < T(1) - std::numeric_limits<T>::epsilon() ? hv * d / std::sqrt(T(1) - hv2) : v.y1;
   const Vec3<T> p = xu * v.x + yv * v.y + v.z0 * v.z;
