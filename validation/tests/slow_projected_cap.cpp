@@ -10,27 +10,14 @@
 #include <string>
 #include <vector>
 
-#include "warpcheck/validation/projected_cap_claims.h"
+#include "projected_cap_fixtures.h"
 
 namespace warpcheck::validation {
 namespace {
 
 using namespace projected_cap_test;
 
-TEST(ProjectedCapCase3, DensityRatioNeverExceedsPapersBoundOn1e5RandomConfigurations) {
-  // Long double: in double the density's rounding near Case 4 (d/r ~ 760, depth 0.99993) lifted the ratio to
-  // 1 + 2.8e-8 times the bound (projected_cap_claims, double run). (1e4 in the fast suite.)
-  const Case3RatioStats s = case3_ratio_search<long double>(100'000, 8, 20260501);
-  EXPECT_EQ(s.configurations, 100'000);
-  // The bound is attained (at the corners of the cut disk), so ratio / bound - 1 is rounding noise of either sign;
-  // it must stay below the rounding error estimated by comparing with double (see Case3RatioStats).
-  EXPECT_LE(s.worst_excess_over_rounding, 0.0) << "max ratio/bound " << s.worst_ratio_over_bound << " at d/r = "
-                                                << s.worst_d_over_r << ", depth " << s.worst_depth;
-  EXPECT_GT(s.worst_ratio_over_bound, 1 - 1e-9);  // the grid reaches the extremes: the bound is sharp
-  EXPECT_LE(s.worst_ratio_d_ge_1_094, 2.0);
-  EXPECT_LE(s.worst_ratio_d_ge_2, std::sqrt(2.0));
-  EXPECT_GT(s.worst_ratio_d_ge_2, 1.3);  // configurations near the limit were drawn
-}
+TEST(ProjectedCapCase3, DensityRatioNeverExceedsPapersBoundOn1e5RandomConfigurations) { expect_case3_ratio_within_bound(100'000); }
 
 TEST(ProjectedCapLambertian, EstimateIsUnbiasedInCase3ForBothInverses) {
   // E[cos/pdf] over primary sample space by tanh-sinh quadrature equals the independent projected solid angle.

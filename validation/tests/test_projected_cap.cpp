@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "warpcheck/validation/projected_cap_claims.h"
+#include "projected_cap_fixtures.h"
 
 namespace warpcheck::validation {
 namespace {
@@ -39,19 +39,7 @@ TEST(ProjectedCapQuintic, ExactInverseOfTheKernelAgreesWithBoostToms748InverseOf
 
 // ---- Sec. 3.5: the Case-3 density ratio bound ---------------------------------------------------------------
 
-TEST(ProjectedCapCase3, DensityRatioNeverExceedsPapersBoundOn1e4RandomConfigurations) {
-  // Long double; 1e6 configurations in slow_projected_cap.cpp. The bound is attained (at the cut disk's corners),
-  // so ratio / bound - 1 is rounding of either sign: it must stay below the derived rounding allowance
-  // (case3_rounding_allowance in projected_cap_claims.h).
-  const Case3RatioStats s = case3_ratio_search<long double>(10'000, 8, 20260501);
-  EXPECT_EQ(s.configurations, 10'000);
-  EXPECT_LE(s.worst_excess_over_rounding, 0.0) << "max ratio/bound " << s.worst_ratio_over_bound << " at d/r = "
-                                                << s.worst_d_over_r << ", depth " << s.worst_depth;
-  EXPECT_GT(s.worst_ratio_over_bound, 1 - 1e-9);  // the grid reaches the extremes: the bound is sharp
-  EXPECT_LE(s.worst_ratio_d_ge_1_094, 2.0);
-  EXPECT_LE(s.worst_ratio_d_ge_2, std::sqrt(2.0));
-  EXPECT_GT(s.worst_ratio_d_ge_2, 1.3);  // configurations near the limit were drawn
-}
+TEST(ProjectedCapCase3, DensityRatioNeverExceedsPapersBoundOn1e4RandomConfigurations) { expect_case3_ratio_within_bound(10'000); }
 
 TEST(ProjectedCapCase3, RatioTestCatchesADensityTwoPercentAboveTheBound) {
   // Negative control: the same comparison against the bound scaled by 0.98 must report an excess.
