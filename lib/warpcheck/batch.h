@@ -141,11 +141,12 @@ NoSample sample_sphere_solid_angle_batch(const SphereView<T>& v, const T* __rest
       norm[j] = wx * wx + wy * wy + wz * wz;
     }
     ArrayMap(norm, m) = ArrayMap(norm, m).sqrt();
-    // Renormalise like the scalar kernel (Eigen's normalized()); the norm is 1 up to rounding, never 0.
+    // Renormalise like the scalar kernel (renormalized() of core.h); the norm is 1 up to rounding, never 0.
     for (std::size_t j = 0; j < m; ++j) {
-      ox[i0 + j] /= norm[j];
-      oy[i0 + j] /= norm[j];
-      oz[i0 + j] /= norm[j];
+      const T inv = T(1) / norm[j];
+      ox[i0 + j] *= inv;
+      oy[i0 + j] *= inv;
+      oz[i0 + j] *= inv;
       op[i0 + j] = pdf;
     }
   }

@@ -92,7 +92,7 @@ template <class T> DirectionSample<T> sample_sphere_solid_angle(const SphereView
   const T phi = kTwoPi<T> * u[1];
   DirectionSample<T> s;
   s.direction =
-      v.frame.to_world(Vec3<T>(sin_theta * std::cos(phi), sin_theta * std::sin(phi), cos_theta)).normalized();
+      renormalized(v.frame.to_world(Vec3<T>(sin_theta * std::cos(phi), sin_theta * std::sin(phi), cos_theta)));
   s.pdf = sphere_solid_angle_density(v);
   return s;
 }
@@ -132,7 +132,7 @@ template <class T> DirectionSample<T> sample_sphere_visible_area(const SphereVie
   // pdf = dist^3 / (cos_light dist * 2 pi r^2 (1 - r/d)), grouped so that no intermediate overflows.
   const T dist_over_r = dist / r;
   DirectionSample<T> out;
-  out.direction = v.frame.to_world(local / dist).normalized();
+  out.direction = renormalized(v.frame.to_world(local / dist));
   out.pdf = dist_over_r * dist_over_r * (dist / cos_light_times_dist) / (kTwoPi<T> * (T(1) - s));
   if (!std::isfinite(out.pdf) || !(out.pdf > T(0))) return DirectionSample<T>::none(NoSample::kTooSmall);
   return out;
