@@ -87,7 +87,9 @@ template <class T> T quintic_g_prime(T s) {
 template <class T> struct CutDiskX {
   T x = T(0);
   T half_height = T(1);
-  T density = T(1);  // density of x per unit disk area when the left-area is uniform (1 for the exact inverse)
+  T inv_density = T(1);  // 1 / density of x per unit disk area when the left-area is uniform (1 for the exact
+                         // inverse); kept inverted so that a sample's pdf costs one division
+  T density() const { return T(1) / inv_density; }
 };
 
 // Exact inverse of the left-area: solves C(theta) = target (target in [0, pi/2]) for theta in [0, pi/2] by
@@ -108,12 +110,14 @@ template <class T> T solve_cut_disk_angle(T target) {
 
 // Density factor of the quintic at distance e = pi/2 - |a - pi/2| from the nearest end of the area range
 // (derived above): 1 / (2 ((2/3) g - g' e) sqrt(g) sqrt(2 - q)), q = g e^(2/3).
-// The same with q = g(s) e^(2/3) already known (the sampler has it: one cube root per sample, not two).
-template <class T> T quintic_density(T s, T e, T q) {
+// Its inverse with q = g(s) e^(2/3) already known (the sampler has it: one cube root per sample, not two).
+template <class T> T quintic_inverse_density(T s, T e, T q) {
   const T g = quintic_g(s), gp = quintic_g_prime(s);
-  return T(1) / (T(2) * (T(2) / T(3) * g - gp * e) * std::sqrt(g * std::max(T(0), T(2) - q)));
+  return T(2) * (T(2) / T(3) * g - gp * e) * std::sqrt(g * std::max(T(0), T(2) - q));
 }
-template <class T> T quintic_density(T s, T e) { return quintic_density(s, e, quintic_g(s) * std::cbrt(e * e)); }
+template <class T> T quintic_density(T s, T e) {
+  return T(1) / quintic_inverse_density(s, e, quintic_g(s) * std::cbrt(e * e));
+}
 
 // SampleCutUnitDisk (Alg. 5), abscissa only: the point whose left-area is `left_area` in [0, pi].
 template <class T, CutDiskInverse M> CutDiskX<T> sample_cut_unit_disk_x(T left_area) {
@@ -127,7 +131,7 @@ template <class T, CutDiskInverse M> CutDiskX<T> sample_cut_unit_disk_x(T left_a
     const T m = T(1) - q;  // |d_x| before the sign (negative inside the fold near a = pi/2)
     out.x = positive ? m : -m;
     out.half_height = std::sqrt(std::max(T(0), q * (T(2) - q)));  // sqrt(1 - m^2) = sqrt((1 - m)(1 + m))
-    out.density = quintic_density(s, e, q);
+    out.inv_density = quintic_inverse_density(s, e, q);
   } else {
     const T theta = solve_cut_disk_angle(e);  // C(theta) = e: the area beyond |x| = cos(theta)
     out.x = positive ? std::cos(theta) : -std::cos(theta);
@@ -278,21 +282,22 @@ template <class T> T lift(T wx, T wy) {
 }
 
 // Piece geometry: 0 ellipse, 1 mirrored disk, 2 Case-3 lune. Maps a cut-disk point to a local direction and
-// gives the projected-solid-angle density from the disk density (per unit area and unit u0).
+// gives the projected-solid-angle density from the INVERSE disk density (per unit area and unit u0), with one
+// division.
 template <class T> struct Local {
   Vec3<T> w;
   T pdf_proj;
 };
 
-template <class T> Local<T> disk_to_local(const ProjectedCapView<T>& p, int piece, T dx, T dy, T disk_density) {
+template <class T> Local<T> disk_to_local(const ProjectedCapView<T>& p, int piece, T dx, T dy, T inv_disk_density) {
   Local<T> o;
   if (piece == 0) {
     const T wx = p.r_x * dx + p.c_x, wy = p.r_y * dy;
     o.w = Vec3<T>(wx, wy, lift(wx, wy));
-    o.pdf_proj = disk_density / (p.r_x * p.r_y);
+    o.pdf_proj = T(1) / (inv_disk_density * (p.r_x * p.r_y));
   } else if (piece == 1) {
     o.w = Vec3<T>(-dx, dy, lift(dx, dy));
-    o.pdf_proj = disk_density;
+    o.pdf_proj = T(1) / inv_disk_density;
   } else {
     const T d_z = lift(dx, dy);
     const T w_z = p.k * d_z;
@@ -301,7 +306,7 @@ template <class T> Local<T> disk_to_local(const ProjectedCapView<T>& p, int piec
     const T w_x = lift(w_y, w_z);
     o.w = Vec3<T>(w_x, w_y, w_z);
     // Alg. 4: p = -t_y^2 / ((c_z + r_z)^2 A_D) w_x / (d_x s_y) = w_x / (k^2 s_y |d_x|) per unit disk density.
-    o.pdf_proj = disk_density * w_x / (p.k * p.k * s_y * std::abs(dx));
+    o.pdf_proj = w_x / (inv_disk_density * (p.k * p.k) * s_y * std::abs(dx));
   }
   return o;
 }
@@ -399,7 +404,7 @@ DirectionSample<T> sample_projected_spherical_cap(const ProjectedCapView<T>& p, 
   const Piece<T>& pc = ps[i];
   const CutDiskX<T> d = sample_cut_unit_disk_x<T, M>(pc.alpha + pc.beta * u0);  // Alg. 5
   const T dy = (T(2) * u1 - T(1)) * d.half_height;
-  const Local<T> loc = disk_to_local(p, pc.kind, d.x, dy, d.density / std::abs(pc.beta));
+  const Local<T> loc = disk_to_local(p, pc.kind, d.x, dy, d.inv_density * std::abs(pc.beta));
   T pdf_proj = loc.pdf_proj;
   if constexpr (M == CutDiskInverse::kQuintic) {
     // Where another piece or the other branch of the quintic also reaches this direction (the fold at

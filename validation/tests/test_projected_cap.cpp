@@ -128,7 +128,7 @@ TEST(ProjectedCapQuintic, DensityFactorMatchesFiniteDifferencesOfTheQuinticWarp)
     const Real dxda = (x(a + step).x - x(a - step).x) / (2 * step);
     const CutDiskX<Real> c = x(a);
     const Real fd = 1 / (2 * c.half_height * std::abs(dxda));
-    worst = std::max(worst, std::abs(fd / c.density - 1));
+    worst = std::max(worst, std::abs(fd / c.density() - 1));
   }
   EXPECT_LT(worst, 1e-8L);  // central differences at step 1e-6 in long double: truncation ~1e-12, rounding ~1e-13
 }
