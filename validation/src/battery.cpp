@@ -485,7 +485,7 @@ TestResult pdf_consistency(const SamplerUnderTest& s, const BatteryOptions& o) {
   std::mt19937_64 g = stream(o.seed, s, 2, 0);
   Real worst_self = 0, worst_jac = 0;
   Real worst_u[2] = {0, 0};
-  std::size_t checked = 0, skipped = 0, declined = 0;
+  std::size_t checked = 0, skipped = 0, declined = 0, unresolved = 0;
   for (int k = 0; k < o.consistency_points; ++k) {
     const Real u0 = uniform01(g), u1 = uniform01(g);
     // Step: 1e-4, shrunk near the domain's edges and documented kinks so that the stencil stays on one
@@ -506,6 +506,16 @@ TestResult pdf_consistency(const SamplerUnderTest& s, const BatteryOptions& o) {
     }
     const Real self = s.pdf(x.direction);
     const Real jac = warp_density(warp, u0, u1, h);
+    // Resolution: the same difference with 2h. Where the two disagree by more than a quarter of the tolerance,
+    // rounding noise of the reference warp (~eps_L / h relative, amplified by cancellation in the kernel, e.g.
+    // a 1 mm light 40 m away: 1e-6 at h = 1e-5, measured) or a kink inside the stencil dominates, and the point
+    // says nothing about the kernel: it is counted as unresolved, not checked. A warp whose density is wrong is
+    // wrong at both steps alike, so this does not hide a bias; too many unresolved points fail the test.
+    const Real jac2 = warp_density(warp, u0, u1, 2 * h);
+    if (std::isfinite(jac) && std::isfinite(jac2) && !(std::abs(jac / jac2 - 1) <= s.tolerance / 4)) {
+      ++unresolved;
+      continue;
+    }
     const Real e_self = std::abs(self / x.pdf - 1);
     const Real e_jac = std::isfinite(jac) ? std::abs(x.pdf / jac - 1) : std::numeric_limits<Real>::infinity();
     if (!(e_self <= worst_self)) worst_self = std::isnan(e_self) ? std::numeric_limits<Real>::infinity() : e_self;
@@ -516,11 +526,14 @@ TestResult pdf_consistency(const SamplerUnderTest& s, const BatteryOptions& o) {
     ++checked;
   }
   r.statistic = double(std::max(worst_self, worst_jac));
-  r.passed = declined == 0 && checked > 0 && r.statistic <= double(s.tolerance);
+  // At most 5% of the points unresolved: beyond that the check has lost its power and fails.
+  r.passed = declined == 0 && checked > 0 && 20 * unresolved <= std::size_t(o.consistency_points) &&
+             r.statistic <= double(s.tolerance);
   std::ostringstream detail;
   detail << "max |pdf(dir)/pdf - 1| " << double(worst_self) << ", max |pdf * area element - 1| " << double(worst_jac)
          << " at u=(" << double(worst_u[0]) << "," << double(worst_u[1]) << "); " << checked << " points, " << skipped
-         << " skipped at kinks/edges, " << declined << " declined; tolerance " << double(s.tolerance);
+         << " skipped at kinks/edges, " << unresolved << " unresolved (steps h and 2h disagree by > tolerance / 4; "
+         << "at most 5% allowed), " << declined << " declined; tolerance " << double(s.tolerance);
   if (!s.tolerance_note.empty()) detail << " (" << s.tolerance_note << ")";
   r.detail = detail.str();
   return r;
