@@ -213,9 +213,31 @@ std::vector<PolygonConfig> configs() {
   };
 }
 
+// Documented expected failures (Case::known_limitation), with the measurements that put them here
+// (`warpcheck validate --kernel '*polygon*' --kernel 'baseline-*' --scalar double --threads 1`, 1e7 samples):
+//  * the biased variant (Sec. 6.4) is biased by design: no iteration (the two-quad initialisation is the answer,
+//    backward error up to 0.27 in the paper) and an approximate arctangent (<= 1.2e-5 rad) in the sector areas.
+//    At 1e7 samples the battery sees it, which is the point of listing it: measured in double chi2 p = 0 on
+//    straddling-horizon, pdf-consistency up to 6.8e-2 (decentral-square), normalisation 2.8e-6 (central-square)
+//    to 1.3e-4 (far-1cm).
+//  * Arvo 1995 as published on tiny distant lights (Peters 2021 Sec. 5 and Fig. 7: its solid-angle inversion
+//    cancels): measured in double pdf-consistency 6.7e-4 (far-1cm) and 1 (far-1mm: samples outside the light).
+const char* polygon_known_limitation(const std::string& kernel, const std::string& scalar, const std::string& config) {
+  if (config == "below-horizon") return "";
+  if (kernel == "polygon-projected-solid-angle-biased")
+    return "biased by design (Peters 2021 Sec. 6.4: no iteration, arctangent approximated to 1.2e-5 rad); the "
+           "battery is expected to see the bias at 1e7 samples (double: chi2 p = 0 straddling-horizon, "
+           "pdf-consistency 6.8e-2 decentral-square, normalisation 2.8e-6..1.3e-4); see registry_polygon.cpp";
+  if (kernel == "baseline-arvo-triangle" && scalar != "long double" && (config == "far-1cm" || config == "far-1mm"))
+    return "Arvo 1995 as published cancels on tiny distant triangles (Peters 2021 Sec. 5, Fig. 7): double "
+           "pdf-consistency 6.7e-4 (1 cm at 40 m) and 1 (1 mm: samples outside the light); a baseline, not fixed";
+  return "";
+}
+
 template <template <class> class K, class T>
 void add_case(Registry& r, const char* kernel, const PolygonConfig& c, Measure measure) {
   Case k;
+  k.known_limitation = polygon_known_limitation(kernel, scalar_name<T>(), c.name);
   k.kernel = kernel;
   k.scalar = scalar_name<T>();
   k.config = c.name;
@@ -283,7 +305,7 @@ void register_polygon_kernels(Registry& r) {
     add_all_scalars<TurkKernel>(r, "baseline-turk-area", c, Measure::kArea);
     if (c.rectangle) add_all_scalars<UrenaKernel>(r, "baseline-urena-rectangle", c, Measure::kSolid);
   }
-  // Known limitations (measured; see the issue report): set on the matching cases.
+  // Known limitations: polygon_known_limitation() above, set per case by add_case.
 }
 
 }  // namespace warpcheck::validation
