@@ -264,6 +264,7 @@ void add_kernel(std::vector<Search>& v, const std::string& kernel, const std::st
                         : kernel + " (" + what + ") in " + scalar + ": backward error max(|du0|, |du1|) explaining its sample "
                           "direction by the long double warp (first order, 4th-order differences with h = 1e-6)";
     s.paper = "";
+    s.resolution_depends_on_cpu = metric == Metric::kBackward;
     s.parameters = with_u(Family::parameters(), metric == Metric::kAngle ? L(1e-6L) : L(1e-5L));
     s.objective = [metric](std::span<const L> p) { return precision_error<Family, K, T>(p, metric); };
     v.push_back(std::move(s));
@@ -278,6 +279,7 @@ void add_kernel(std::vector<Search>& v, const std::string& kernel, const std::st
                   "element |dw/du0 x dw/du1| by 4th-order differences (h = 1e-5; points where h and 2h disagree by "
                   "> 1e-7 are skipped as kinks)";
   s.paper = "";
+  s.resolution_depends_on_cpu = true;
   s.parameters = with_u(Family::parameters(), 1e-4L);
   s.objective = [](std::span<const L> p) { return pdf_warp_error<Family, K>(p); };
   v.push_back(std::move(s));

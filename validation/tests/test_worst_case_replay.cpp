@@ -1,13 +1,16 @@
 // Replays the recorded worst cases in data/worst-cases/*.json: a kernel change that makes a recorded case
 // worse fails here. The inputs are stored exactly (hexadecimal long doubles) and the objectives are pure
-// functions evaluated in long double, so an unchanged kernel reproduces the recorded error bit for bit; the
-// comparison is therefore exact (<=), with no tolerance.
+// functions evaluated in long double, so an unchanged kernel on the same CPU reproduces the recorded error bit
+// for bit; the comparison allows only kReplaySlack (below). Across CPUs the long double transcendental
+// functions (x87 fpatan and friends) may differ in their last bits, which can flip a finite-difference
+// resolution test at the recorded input: see Search::resolution_depends_on_cpu.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <sstream>
 
 #include "warpcheck/validation/searches.h"
@@ -53,6 +56,13 @@ TEST(RecordedWorstCases, AreNoWorseWithTheCurrentKernels) {
     EXPECT_EQ(name, r.search + ".json");
     ASSERT_EQ(r.best_x.size(), s->parameters.size());
     const long double now = s->objective(r.best_x);
+    if (std::isnan(now) && s->resolution_depends_on_cpu) {
+      // Not a verdict on the kernel: the finite-difference resolution test at this input came out the other
+      // way on this CPU (see Search::resolution_depends_on_cpu). Reported, and the record stays as it is.
+      std::cout << "note: " << name << ": the recorded input is unresolved on this CPU (h and 2h differences "
+                   "disagree); not compared\n";
+      continue;
+    }
     EXPECT_FALSE(std::isnan(now)) << "the recorded input is no longer a valid point of " << r.search;
     // Slack of one part in 1e9: a kernel edit that only changes rounding moves a recorded error by ~1e-12
     // relative (measured after the issue-7 fixes to polygon_projected.h), which is not a regression; a worst
