@@ -506,5 +506,48 @@ TYPED_TEST(PolygonKernels, SolidAngleSamplesLieInsideTheLightSeenFromCloseToItsP
               validation_scalar_name<T>(), worst[0], worst[1], checked[0], checked[1]);
 }
 
+// check_polygon's planarity tolerance is relative to the polygon's width (8 sqrt(eps) of it, plus the
+// coordinates' rounding), and a polygon narrower than that tolerance is rejected: its plane is undetermined.
+TYPED_TEST(PolygonKernels, ThinPolygonsArePlanarRelativeToTheirWidth) {
+  using T = TypeParam;
+  const T eps = std::numeric_limits<T>::epsilon();
+  std::string message;
+  // A strip of aspect 1 : 1e-2 (float) or 1e-6 (double, long double), planar: accepted, and sampled.
+  const T w = std::is_same_v<T, float> ? T(1e-2) : T(1e-6);
+  const PolygonLight<T> strip{Vec3<T>(-1, 0, 1), Vec3<T>(1, 0, 1), Vec3<T>(1, w, 1), Vec3<T>(-1, w, 1)};
+  EXPECT_EQ(check_polygon(strip, &message), NoSample::kNone) << message;
+  EXPECT_TRUE(sample_polygon_solid_angle(geom<T>(Vec3<T>::Zero(), Vec3<T>(0, 0, 1), strip), Vec2<T>(0.3, 0.6)).valid());
+  // The same strip with one corner off its plane by a tenth of its width (far below the old tolerance of
+  // 8 sqrt(eps) times the diameter): not coplanar.
+  PolygonLight<T> bent = strip;
+  bent.vertices[2].z() += w / 10;
+  EXPECT_EQ(check_polygon(bent, &message), NoSample::kInvalidGeometry);
+  EXPECT_NE(message.find("not coplanar"), std::string::npos) << message;
+  // fuzz_polygon_solid_angle_double 4252de58...: width 11, diameter 1.3e8, one vertex 7.9 off the plane.
+  if constexpr (!std::is_same_v<T, float>) {
+    const PolygonLight<T> kite{Vec3<T>(7.9375, 0, 2), Vec3<T>(1 - eps / 2, -6, 0), Vec3<T>(0, 2, 0), Vec3<T>(0, -8, 0),
+                               Vec3<T>(0, 0, -134217728)};
+    EXPECT_EQ(check_polygon(kite, &message), NoSample::kInvalidGeometry);
+    EXPECT_NE(message.find("not coplanar"), std::string::npos) << message;
+  }
+  // A sliver: the strip's width at its coordinates' rounding. Narrower than its planarity tolerance.
+  const PolygonLight<T> sliver{Vec3<T>(-1, 0, 1), Vec3<T>(1, 0, 1), Vec3<T>(1, 16 * eps, 1), Vec3<T>(-1, 16 * eps, 1)};
+  EXPECT_EQ(check_polygon(sliver, &message), NoSample::kZeroSize);
+  EXPECT_NE(message.find("narrower than its planarity tolerance"), std::string::npos) << message;
+  for (NoSample r : all_reasons(geom<T>(Vec3<T>(0, -1, 0), Vec3<T>(0, 0, 1), sliver))) EXPECT_EQ(r, NoSample::kZeroSize);
+  // fuzz_polygon_solid_angle_double 6815131d...: eight vertices within 1e-16 of a line (an ellipse squashed to
+  // rounding), coordinates ~2.
+  if constexpr (std::is_same_v<T, double>) {
+    const PolygonLight<T> squashed{
+        Vec3<T>(6.0000000190264611e-30, 2.0000000063421537e-30, -3.0000000095132306e-30),
+        Vec3<T>(5.1213203597997434e-30, -1.4142135623730949, -1.4142135623730949),
+        Vec3<T>(3.0000000095132309e-30, -2, -2), Vec3<T>(8.7867965922671845e-31, -1.4142135623730951, -1.4142135623730951),
+        Vec3<T>(0, -2.4492935982947464e-16, -2.4492935982946566e-16),
+        Vec3<T>(8.7867965922671775e-31, 1.4142135623730949, 1.4142135623730949), Vec3<T>(3.0000000095132299e-30, 2, 2),
+        Vec3<T>(5.121320359799742e-30, 1.4142135623730954, 1.4142135623730954)};
+    EXPECT_EQ(check_polygon(squashed), NoSample::kZeroSize);
+  }
+}
+
 }  // namespace
 }  // namespace warpcheck
