@@ -128,8 +128,8 @@ template <class T> NoSample check_polygon(const PolygonLight<T>& p, std::string*
   // that we allow 8 sqrt(eps) of the polygon's width (a clearly non-planar or reflex polygon exceeds it by far).
   // The width, not the diameter: a thin polygon whose vertices may leave its plane by a fraction of its
   // diameter has no meaningful plane (found by fuzz_polygon_solid_angle_double, 4252de58...: width 11, diameter
-  // 1.3e8, one vertex 7.9 off the plane of the others accepted with the old tolerance 16, and samples 9.2e-3 rad
-  // outside the light; issue 4). For a convex polygon |area2| / diameter = 2 area / diameter lies between the
+  // 1.3e8, one vertex 7.9 off the plane of the others accepted with the old tolerance 16, samples 9.2e-3 rad
+  // outside the light in that campaign; issue 4). For a convex polygon |area2| / diameter = 2 area / diameter lies between the
   // width w and 2 w (it contains a triangle on its diameter of height >= w / 2 and lies in a strip of width w).
   const T eps = std::numeric_limits<T>::epsilon();
   const T width = area2_norm / diameter;
