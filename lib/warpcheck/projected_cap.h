@@ -159,10 +159,13 @@ template <class T> T quintic_density(T s, T e) {
 // SampleCutUnitDisk (Alg. 5), abscissa only: the point whose left-area is `left_area` in [0, pi] (exactly for
 // kExact; for kQuintic the rescaled quintic above, whose density per unit left-area is 1 / (kappa times the
 // inverse factor of quintic_inverse_density)).
-template <class T, CutDiskInverse M> CutDiskX<T> sample_cut_unit_disk_x(T left_area) {
+// right_area = pi - left_area, computed by the caller without cancellation (pi - a loses the digits of a small
+// right-area: absolute error eps pi, 1.7e-4 relative for float at u0 = 1 - 3.6e-5 in Case 1).
+template <class T, CutDiskInverse M> CutDiskX<T> sample_cut_unit_disk_x(T left_area, T right_area) {
   const T a = std::clamp(left_area, T(0), kPi<T>);
-  const T e = std::min(a, kPi<T> - a);  // pi/2 - |A| of Alg. 5, without cancellation near the ends
   const bool positive = a >= kPi<T> / T(2);
+  // pi/2 - |A| of Alg. 5: the area between the point and the nearer end of the disk.
+  const T e = positive ? std::clamp(right_area, T(0), kPi<T> / T(2)) : a;
   CutDiskX<T> out;
   if constexpr (M == CutDiskInverse::kQuintic) {
     const T er = kQuinticKappa<T> * e;  // the rescaled argument: er <= e0, so q <= 1 and no fold
@@ -179,6 +182,9 @@ template <class T, CutDiskInverse M> CutDiskX<T> sample_cut_unit_disk_x(T left_a
   }
   return out;
 }
+template <class T, CutDiskInverse M> CutDiskX<T> sample_cut_unit_disk_x(T left_area) {
+  return sample_cut_unit_disk_x<T, M>(left_area, kPi<T> - left_area);
+}
 
 // The left-area a in [0, pi] whose cut-disk abscissa is x (half-height hh = sqrt(1 - x^2), passed for accuracy
 // near the disk's edge), with the density there; the inverse of sample_cut_unit_disk_x. One preimage: both
@@ -186,10 +192,11 @@ template <class T, CutDiskInverse M> CutDiskX<T> sample_cut_unit_disk_x(T left_a
 template <class T> struct CutDiskPreimage {
   T left_area;
   T density;
+  T right_area;  // pi - left_area, without cancellation
 };
 template <class T, CutDiskInverse M> CutDiskPreimage<T> cut_disk_preimage(T x, T hh) {
   if constexpr (M == CutDiskInverse::kExact) {
-    return {unit_disk_area_left_of(x, hh), T(1)};
+    return {unit_disk_area_left_of(x, hh), T(1), unit_disk_area_left_of(-x, hh)};
   } else {
     // q = 1 - |x|, from hh when that is more accurate; solve q = g(pi/2 - t^3) t^2 for t = er^(1/3) (smooth in
     // t, so Newton converges near the disk's edge where dx/da is infinite), t in [0, e0^(1/3)].
@@ -206,7 +213,8 @@ template <class T, CutDiskInverse M> CutDiskPreimage<T> cut_disk_preimage(T x, T
         },
         guess, T(0), t_max, std::numeric_limits<T>::digits - 2, iterations);
     const T er = t * t * t, e = er / kQuinticKappa<T>;
-    return {x >= T(0) ? kPi<T> - e : e, quintic_density(kPi<T> / T(2) - er, er) / kQuinticKappa<T>};
+    return {x >= T(0) ? kPi<T> - e : e, quintic_density(kPi<T> / T(2) - er, er) / kQuinticKappa<T>,
+            x >= T(0) ? e : kPi<T> - e};
   }
 }
 
@@ -224,8 +232,13 @@ template <class T> struct ProjectedCapView {
   // The left-areas at which the rescaled quintic reaches the cuts exactly (Cases 2-3; see "The quintic of
   // Alg. 5" above): X(quintic_area_e_unit) = X_t for the ellipse, X(quintic_area_d) = -t_x for the disk.
   T quintic_area_e_unit = T(0), quintic_area_d = T(0);
-  // Case 3: z scale k = (c_z + r_z) / t_y, c_z + r_z and r_z - c_z.
-  T k = T(0), top = T(0), rz_minus_cz = T(0);
+  // pi - area_e_unit and pi - quintic_area_e_unit, without cancellation (the ellipse piece's right-areas at tau).
+  T right_e_unit = T(0), quintic_right_e_unit = T(0);
+  // Case 3: z scale k = (c_z + r_z) / t_y, c_z + r_z and r_z - c_z. Cases 1-2: c_z - r_z, the height of the
+  // ellipse's point d_x = 1 (lowest point of the cap's boundary), = (h^2 - r_y^2) / (h v + w_dx r_y).
+  T k = T(0), top = T(0), rz_minus_cz = T(0), cz_minus_rz = T(0);
+  // 1 - c_x = 1 - w_dx v = (h^2 + w_dx^2 r_y^2) / (1 + w_dx v), for the inverse of the ellipse piece.
+  T one_minus_cx = T(0);
 
   bool valid() const { return reason == NoSample::kNone; }
   Vec3<T> to_world(const Vec3<T>& w) const { return w.x() * x + w.y() * y + w.z() * z; }
@@ -262,6 +275,12 @@ template <class T> ProjectedCapView<T> make_projected_cap_view(const SphereLight
   p.r_x = p.h * p.r_y, p.r_z = p.w_dx * p.r_y, p.c_x = p.w_dx * p.v, p.c_z = p.h * p.v;
   const T h = p.h, ry = p.r_y, v = p.v;
   if (h <= -ry) return p.reason = NoSample::kBelowHorizon, p;  // Case 4 (make_sphere_view catches it first)
+  // r_y^2 - h^2 = w_dx^2 - v^2 (h^2 + w_dx^2 = r_y^2 + v^2 = 1), each form from the smaller operands: for a large
+  // cap (r_y ~ 1) seen overhead (h ~ 1), r_y - h would cancel through r_y's rounding (1.4e-5 in float pdfs of
+  // near-touching, ProjectedCapFloat test); near the case boundary r_y = |h| both cancel (inherent).
+  const T chord2 = ry < v ? (ry - std::abs(h)) * (ry + std::abs(h)) : (p.w_dx - v) * (p.w_dx + v);
+  if (h >= T(0)) p.cz_minus_rz = -chord2 / (h * v + p.w_dx * ry);
+  p.one_minus_cx = (h * h + p.w_dx * p.w_dx * ry * ry) / (T(1) + p.w_dx * v);
   if (h >= ry) {
     // Case 1 (Alg. 3): the whole ellipse; t_x >= 1 is never needed.
     p.which_case = 1;
@@ -270,7 +289,7 @@ template <class T> ProjectedCapView<T> make_projected_cap_view(const SphereLight
     p.total = p.area_e;
     p.tau = T(1);
   } else {
-    const T chord2 = (ry - std::abs(h)) * (ry + std::abs(h));  // r_y^2 - h^2 > 0
+    // chord2 = r_y^2 - h^2 > 0 (above)
     p.t_x = v / p.w_dx;                                       // w_dx >= v > 0 here
     p.t_y = std::sqrt(chord2) / p.w_dx;
     p.area_d = cut_disk_area_from_angle(std::atan2(std::sqrt(chord2), v));  // pi/2 - A(t_x)
@@ -278,10 +297,13 @@ template <class T> ProjectedCapView<T> make_projected_cap_view(const SphereLight
     if (h >= T(0)) {
       // Case 2 (Alg. 2). A_E' = pi/2 + A(X_t) = pi - C(theta_E), X_t = cos(theta_E) = v h / (r_y w_dx).
       p.which_case = 2;
-      p.area_e_unit = kPi<T> - cut_disk_area_from_angle(std::atan2(std::sqrt(chord2), v * h));
+      p.right_e_unit = cut_disk_area_from_angle(std::atan2(std::sqrt(chord2), v * h));
+      p.area_e_unit = kPi<T> - p.right_e_unit;
       // X_t and its half-height sqrt(1 - X_t^2) (header comment).
-      p.quintic_area_e_unit =
-          cut_disk_preimage<T, CutDiskInverse::kQuintic>(v * h / (ry * p.w_dx), std::sqrt(chord2) / (ry * p.w_dx)).left_area;
+      const CutDiskPreimage<T> qe =
+          cut_disk_preimage<T, CutDiskInverse::kQuintic>(v * h / (ry * p.w_dx), std::sqrt(chord2) / (ry * p.w_dx));
+      p.quintic_area_e_unit = qe.left_area;
+      p.quintic_right_e_unit = qe.right_area;
       p.area_e = p.r_x * p.r_y * p.area_e_unit;
       p.total = p.area_e + p.area_d;
       p.tau = p.area_e / p.total;
@@ -310,9 +332,9 @@ template <class T> T case3_sy(const ProjectedCapView<T>& p, T d_z, T w_z) {
   return std::sqrt(std::max(T(0), num / den));
 }
 
-// w_z = sqrt(1 - w_x^2 - w_y^2). Near the rim the sum of squares (rounding ~1.5 eps) is as accurate as
-// (1 - rho)(1 + rho) with rho = hypot (~1 ulp in rho, 2 eps in 1 - rho^2), and 1 - r2 is exact there
-// (Sterbenz); hypot's overflow care is not needed for |w| <= 1 and cost 9 ns of an 80-ns sample.
+// w_z = sqrt(1 - w_x^2 - w_y^2) for a point of the unit disk (used only for the Case-3 w_x, where no better
+// form is known; see disk_to_local). Near the rim the sum of squares (rounding ~1.5 eps) is as accurate as
+// (1 - rho)(1 + rho) with rho = hypot, and hypot's overflow care is not needed for |w| <= 1.
 template <class T> T lift(T wx, T wy) {
   return std::sqrt(std::max(T(0), T(1) - (wx * wx + wy * wy)));
 }
@@ -325,17 +347,30 @@ template <class T> struct Local {
   T pdf_proj;
 };
 
-template <class T> Local<T> disk_to_local(const ProjectedCapView<T>& p, int piece, T dx, T dy, T inv_disk_density) {
+// The cut-disk point is (d_x, d_y) with d_y = (2 u1 - 1) hh and hh = sqrt(1 - d_x^2) as Alg. 5 returns it.
+// Heights are computed without the cancellation of 1 - w_x^2 - w_y^2 (absolute error eps, so relative error
+// eps / w_z^2 near the horizon: 1.5e-4 in float pdfs at the rim of case tangent-horizon, and for a tiny light
+// straddling the horizon, w_x ~ 1 - 1e-6, no significant digit of w_z at all), by exact identities:
+//  * unit disk: 1 - d_x^2 - d_y^2 = hh^2 (1 - (2 u1 - 1)^2) = 4 hh^2 u1 (1 - u1), so d_z = 2 hh sqrt(u1 (1 - u1));
+//  * ellipse (w_x = r_x d_x + c_x, w_y = r_y d_y; h^2 + w_dx^2 = v^2 + r_y^2 = 1):
+//      1 - w_x^2 - w_y^2 = (c_z - r_z d_x)^2 + r_y^2 (1 - d_x^2 - d_y^2),
+//    a sum of squares, where c_z - r_z d_x = (c_z - r_z) + r_z hh^2 / (1 + d_x) for d_x > 0 (c_z - r_z from the
+//    view, without cancellation) and c_z + r_z |d_x| otherwise. The identity is ours (not in the paper).
+template <class T>
+Local<T> disk_to_local(const ProjectedCapView<T>& p, int piece, T dx, T hh, T u1, T inv_disk_density) {
   Local<T> o;
+  const T dy = (T(2) * u1 - T(1)) * hh;
+  const T d_z = T(2) * hh * std::sqrt(u1 * (T(1) - u1));
   if (piece == 0) {
     const T wx = p.r_x * dx + p.c_x, wy = p.r_y * dy;
-    o.w = Vec3<T>(wx, wy, lift(wx, wy));
+    const T low = dx > T(0) ? p.cz_minus_rz + p.r_z * (hh * hh / (T(1) + dx)) : p.c_z - p.r_z * dx;
+    const T rest = p.r_y * d_z;
+    o.w = Vec3<T>(wx, wy, std::sqrt(low * low + rest * rest));
     o.pdf_proj = T(1) / (inv_disk_density * (p.r_x * p.r_y));
   } else if (piece == 1) {
-    o.w = Vec3<T>(-dx, dy, lift(dx, dy));
+    o.w = Vec3<T>(-dx, dy, d_z);
     o.pdf_proj = T(1) / inv_disk_density;
   } else {
-    const T d_z = lift(dx, dy);
     const T w_z = p.k * d_z;
     const T s_y = case3_sy(p, d_z, w_z);
     const T w_y = s_y * dy;
@@ -349,15 +384,26 @@ template <class T> Local<T> disk_to_local(const ProjectedCapView<T>& p, int piec
 
 // Inverse of disk_to_local: the cut-disk point (d_x, d_y) of a local direction w, and the area factor
 // (projected area per disk area); false when w is not in the piece's image of the unit disk.
+// Like disk_to_local, without cancellation where the direction's own digits allow it: for w_x > 1/2 the ellipse's
+// d_x = (w_x - c_x) / r_x is written ((1 - c_x) - (1 - w_x)) / r_x with 1 - w_x = (w_y^2 + w_z^2) / (1 + w_x)
+// and 1 - c_x from the view (a light of angular radius 2e-3 has r_x ~ 1e-6 near the horizon, below float's
+// resolution of w_x ~ 1), and the unit disk's half-height at d_x is sqrt(d_y^2 + d_z^2) (= sqrt(1 - d_x^2) on
+// the unit sphere, without the cancellation of 1 - d_x^2 when |d_x| ~ 1).
 template <class T> bool local_to_disk(const ProjectedCapView<T>& p, int piece, const Vec3<T>& w, T& dx, T& dy,
                                       T& hh, T& area_factor) {
   if (piece == 0) {
     if (!(p.r_x > T(0))) return false;
-    dx = (w.x() - p.c_x) / p.r_x, dy = w.y() / p.r_y;
+    dx = w.x() > T(0.5) ? (p.one_minus_cx - (w.y() * w.y() + w.z() * w.z()) / (T(1) + w.x())) / p.r_x
+                        : (w.x() - p.c_x) / p.r_x;
+    dy = w.y() / p.r_y;
     area_factor = p.r_x * p.r_y;
+    const T rest = (T(1) - std::abs(dx)) * (T(1) + std::abs(dx));
+    if (!(rest >= T(0))) return false;
+    hh = std::sqrt(rest);
   } else if (piece == 1) {
     dx = -w.x(), dy = w.y();
     area_factor = T(1);
+    hh = std::sqrt(dy * dy + w.z() * w.z());
   } else {
     if (!(w.x() > T(0))) return false;
     const T d_z = w.z() / p.k;
@@ -368,10 +414,8 @@ template <class T> bool local_to_disk(const ProjectedCapView<T>& p, int piece, c
     if (!(rest >= T(0))) return false;
     dx = -std::sqrt(rest);
     area_factor = p.k * p.k * s_y * std::abs(dx) / w.x();
+    hh = std::sqrt(dy * dy + d_z * d_z);
   }
-  const T rest = (T(1) - std::abs(dx)) * (T(1) + std::abs(dx));
-  if (!(rest >= T(0))) return false;
-  hh = std::sqrt(rest);
   return std::abs(dy) <= hh && std::isfinite(area_factor) && area_factor > T(0);
 }
 
@@ -382,16 +426,30 @@ template <class T> bool local_to_disk(const ProjectedCapView<T>& p, int piece, c
 template <class T> struct Piece {
   int kind;
   T u_lo, u_hi, alpha, beta;
+  T right_hi = T(0);  // pieces with alpha = 0: the right-area pi - a at u_hi, without cancellation
 };
+// Every piece's map is a = beta u0 (alpha = 0) or a = alpha (1 - u0) (alpha = -beta); the second is evaluated in
+// that form: 1 - u0 is exact for u0 >= 1/2, where a is small, and alpha + beta u0 cancels there (relative error
+// eps / (1 - u0) in a: 1.7e-3 in float at u0 = 1 - 3.6e-5, which moved float samples near the disk's edge and
+// put their pdfs 3e-4 off the long double ones; ProjectedCapFloat test).
+template <class T> T piece_left_area(const Piece<T>& pc, T u0) {
+  return pc.alpha == T(0) ? pc.beta * u0 : pc.alpha * (T(1) - u0);
+}
+// pi - a for the same u0: for alpha = 0, right_hi + beta (u_hi - u0) (u_hi - u0 exact near u_hi, where a is
+// near pi); otherwise a <= pi/2 and pi - a does not cancel.
+template <class T> T piece_right_area(const Piece<T>& pc, T u0) {
+  return pc.alpha == T(0) ? pc.right_hi + pc.beta * (pc.u_hi - u0) : kPi<T> - pc.alpha * (T(1) - u0);
+}
 template <class T, CutDiskInverse M> int pieces(const ProjectedCapView<T>& p, std::array<Piece<T>, 2>& out) {
   constexpr bool q = M == CutDiskInverse::kQuintic;
   switch (p.which_case) {
-    case 1: out[0] = {0, T(0), T(1), T(0), kPi<T>}; return 1;
+    case 1: out[0] = {0, T(0), T(1), T(0), kPi<T>, T(0)}; return 1;
     case 2: {
       int n = 0;
       if (p.area_e > T(0)) {
         const T ae = q ? p.quintic_area_e_unit : p.area_e_unit;
-        out[n++] = {0, T(0), p.tau, T(0), q ? ae / p.tau : p.total / (p.r_x * p.r_y)};
+        out[n++] = {0, T(0), p.tau, T(0), q ? ae / p.tau : p.total / (p.r_x * p.r_y),
+                    q ? p.quintic_right_e_unit : p.right_e_unit};
       }
       const T ad = q ? p.quintic_area_d / (T(1) - p.tau) : p.total;
       out[n++] = {1, p.tau, T(1), ad, -ad};
@@ -418,11 +476,11 @@ template <class T, CutDiskInverse M> T pdf_local(const ProjectedCapView<T>& p, c
     T dx, dy, hh, area;
     if (!local_to_disk(p, pc.kind, w, dx, dy, hh, area)) continue;
     const CutDiskPreimage<T> pre = cut_disk_preimage<T, M>(dx, hh);
-    const T a_lo = std::min(pc.alpha + pc.beta * pc.u_lo, pc.alpha + pc.beta * pc.u_hi);
-    const T a_hi = std::max(pc.alpha + pc.beta * pc.u_lo, pc.alpha + pc.beta * pc.u_hi);
+    const T a_lo = std::min(piece_left_area(pc, pc.u_lo), piece_left_area(pc, pc.u_hi));
+    const T a_hi = std::max(piece_left_area(pc, pc.u_lo), piece_left_area(pc, pc.u_hi));
     if (pre.left_area < a_lo || pre.left_area > a_hi) continue;
     if (u) {
-      (*u)[0] = std::clamp((pre.left_area - pc.alpha) / pc.beta, pc.u_lo, pc.u_hi);
+      (*u)[0] = std::clamp(pc.alpha == T(0) ? pre.left_area / pc.beta : T(1) - pre.left_area / pc.alpha, pc.u_lo, pc.u_hi);
       (*u)[1] = hh > T(0) ? std::clamp((dy / hh + T(1)) / T(2), T(0), T(1)) : T(0.5);
     }
     return pre.density / (std::abs(pc.beta) * area);
@@ -445,9 +503,8 @@ DirectionSample<T> sample_projected_spherical_cap(const ProjectedCapView<T>& p, 
   int i = 0;
   while (i + 1 < n && u0 >= ps[i].u_hi) ++i;  // Alg. 2's threshold xi_0 < A_E / (A_E + A_D)
   const Piece<T>& pc = ps[i];
-  const CutDiskX<T> d = sample_cut_unit_disk_x<T, M>(pc.alpha + pc.beta * u0);  // Alg. 5
-  const T dy = (T(2) * u1 - T(1)) * d.half_height;
-  const Local<T> loc = disk_to_local(p, pc.kind, d.x, dy, d.inv_density * std::abs(pc.beta));
+  const CutDiskX<T> d = sample_cut_unit_disk_x<T, M>(piece_left_area(pc, u0), piece_right_area(pc, u0));  // Alg. 5
+  const Local<T> loc = disk_to_local(p, pc.kind, d.x, d.half_height, u1, d.inv_density * std::abs(pc.beta));
   const T pdf = loc.pdf_proj * loc.w.z();
   if (!(pdf > T(0)) || !std::isfinite(pdf)) return DirectionSample<T>::none(NoSample::kOnSilhouette);
   DirectionSample<T> s;

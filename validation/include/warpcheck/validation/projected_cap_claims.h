@@ -80,8 +80,7 @@ template <class T> T case3_density_ratio(const ProjectedCapView<T>& p, int n) {
     const T dx = T(-1) + T(i) / T(n) * (T(1) - p.t_x);
     const T hh = std::sqrt(std::max(T(0), (T(1) - dx) * (T(1) + dx)));
     for (int j = 0; j <= n; ++j) {
-      const T dy = (T(2 * j) / T(n) - T(1)) * hh;
-      const auto o = projected_cap_detail::disk_to_local(p, 2, dx, dy, T(1));
+      const auto o = projected_cap_detail::disk_to_local(p, 2, dx, hh, T(j) / T(n), T(1));
       if (!std::isfinite(o.pdf_proj) || !(o.pdf_proj > 0)) continue;
       mx = std::max(mx, o.pdf_proj), mn = std::min(mn, o.pdf_proj);
     }
