@@ -43,8 +43,8 @@ struct LambertianMoments {
 template <class T, CutDiskInverse M>
 LambertianMoments projected_cap_lambertian_moments(const SphereLightGeometry<Real>& g, Real tol = 1e-10L);
 
-// The measured float error of a configuration (the largest deterministic battery statistic of the float
-// instantiation, rounded up to one significant digit), at least 1e-6.
+// float's tolerance for a configuration: twice its measured float error (the largest deterministic battery
+// statistic of the float kernels, see registry_projected_cap.cpp), rounded up to one digit, at least 1e-6.
 Real projected_cap_float_tolerance(const std::string& config);
 
 }  // namespace warpcheck::validation
