@@ -10,7 +10,8 @@
 //   spherical_rectangle.h  Urena et al. 2013 (rectangles only)
 //
 // Conventions. A polygon has 3 to 8 vertices in world space, in either winding, and must be planar and
-// convex. check_polygon() is the validating constructor's test: it returns kInvalidGeometry (and a message)
+// convex, planar to 8 sqrt(eps) of its width (plus its coordinates' rounding), and wider than that tolerance.
+// check_polygon() is the validating constructor's test: it returns kInvalidGeometry or kZeroSize (and a message)
 // for anything else. Every kernel calls it, so no kernel ever samples invalid input.
 #pragma once
 
@@ -124,9 +125,21 @@ template <class T> NoSample check_polygon(const PolygonLight<T>& p, std::string*
   if (!(area2_norm > T(0)) || !std::isfinite(area2_norm)) return fail(NoSample::kZeroSize, "zero area");
   const Vec3<T> nhat = area2 / area2_norm;
   // Tolerances: input rounding of coordinates of size `magnitude` moves a vertex by ~eps magnitude; beyond
-  // that we allow sqrt(eps) of the diameter (a clearly non-planar or reflex polygon exceeds it by far).
+  // that we allow 8 sqrt(eps) of the polygon's width (a clearly non-planar or reflex polygon exceeds it by far).
+  // The width, not the diameter: a thin polygon whose vertices may leave its plane by a fraction of its
+  // diameter has no meaningful plane (found by fuzz_polygon_solid_angle_double, 4252de58...: width 11, diameter
+  // 1.3e8, one vertex 7.9 off the plane of the others accepted with the old tolerance 16, samples 9.2e-3 rad
+  // outside the light in that campaign; issue 4). For a convex polygon |area2| / diameter = 2 area / diameter lies between the
+  // width w and 2 w (it contains a triangle on its diameter of height >= w / 2 and lies in a strip of width w).
   const T eps = std::numeric_limits<T>::epsilon();
-  const T tol = T(8) * std::sqrt(eps) * diameter + T(64) * eps * magnitude;
+  const T width = area2_norm / diameter;
+  const T tol = T(8) * std::sqrt(eps) * width + T(64) * eps * magnitude;
+  // A polygon narrower than its own planarity tolerance (in effect, narrower than its coordinates' rounding) has
+  // an undetermined plane: rotated about its long axis it stays within the tolerance. Its area vector is rounding
+  // noise, and kernels and references disagree about which side of it a direction lies on (found by
+  // fuzz_polygon_solid_angle_double, 6815131d...: eight vertices within 1e-16 of a line, pdf > 0 half a radian
+  // outside; issue 4; the float slivers of fuzz/README.md's known limits).
+  if (!(width > tol)) return fail(NoSample::kZeroSize, "narrower than its planarity tolerance (zero area up to rounding)");
   for (int i = 0; i < p.count; ++i)
     if (std::abs(nhat.dot(p.vertices[i] - p.vertices[0])) > tol)
       return fail(NoSample::kInvalidGeometry, "vertices are not coplanar");

@@ -71,8 +71,17 @@ template <class T> PolygonFanView<T> make_polygon_fan_view(const PolygonLightGeo
     // issue 7). The midpoint is n x (u_b - u_a), turned towards the light's plane (every direction of the light
     // has plane_normal . w of the sign of plane_distance): no cancellation. At most one such edge exists, the
     // horizon part of a polygon in the upper hemisphere spanning at most 180 degrees.
+    // The fan is then rooted at that midpoint. Rooted at a clip point, the fan still had a triangle holding both
+    // nearly antipodal ends of the horizon edge, joined by a diagonal whose great circle is rounding noise
+    // although it should be the horizon (Eq. 13's 0 / 0 again): found by fuzz_polygon_solid_angle_double
+    // (dd70aa66...: x 4.6e-23 off a triangle of size 5e-16, sample 2.9e-10 rad outside; issue 4), and on random
+    // lights seen from 1e-14..1e-2 of their size off their plane samples up to 0.96 rad outside (test_polygon.cpp,
+    // SolidAngleSamplesLieInsideTheLightSeenFromCloseToItsPlane). The midpoint is 90 degrees from both ends; the
+    // clipped polygon lies in the lune between the horizon and the light's plane (seen from x), so within the
+    // lune's angle of the midpoint, and only a lune near 180 degrees (the light's plane close to the tangent plane
+    // with x just below it) brings a vertex near the midpoint's antipode.
     std::array<Vec3<T>, kMaxFanVertices> q;
-    int nq = 0;
+    int nq = 0, root = 0;
     const Vec3<T> light_normal = pv.frame.to_local(pv.plane_normal);
     for (int i = 0; i < c.count; ++i) {
       const Vec3<T>&a = c.v[i], &b = c.v[(i + 1) % c.count];
@@ -82,10 +91,10 @@ template <class T> PolygonFanView<T> make_polygon_fan_view(const PolygonLightGeo
       if (!(ua.dot(ub) < T(0))) continue;
       Vec3<T> mid = safe_normalized(Vec3<T>(ua.y() - ub.y(), ub.x() - ua.x(), T(0)));
       if (light_normal.dot(mid) * pv.plane_distance < T(0)) mid = -mid;
-      if (!mid.isZero()) q[nq++] = mid * ((a.norm() + b.norm()) / T(2));
+      if (!mid.isZero()) root = nq, q[nq++] = mid * ((a.norm() + b.norm()) / T(2));
     }
     f.count = nq;
-    for (int k = 0; k < nq; ++k) f.p[k] = pv.frame.to_world(q[reverse ? (nq - k) % nq : k]);
+    for (int k = 0; k < nq; ++k) f.p[k] = pv.frame.to_world(q[reverse ? (root - k + nq) % nq : (root + k) % nq]);
     for (int k = 0; k < nq; ++k) f.e[k] = f.p[k] - f.p[0];
   }
   for (int k = 0; k < f.count; ++k) {
@@ -168,15 +177,38 @@ template <class T, std::size_t N> int pick_fan_triangle(const std::array<T, N>& 
   return k;
 }
 
-// Arvo's second step (shared by Section 5 and Arvo 1995): a direction on the arc from b towards c with
-// 1 - cos(angle from b) = xi (1 - b.c), given d = c - b (accurately). With h = |d|^2 / 2 = 1 - b.c, the
-// component of c orthogonal to b is d + h b: no cancellation for short arcs.
+// Arvo's second step (Arvo 1995; used by Section 5): a direction on the arc from b towards c (unit vectors)
+// at the angle phi from b with 1 - cos(phi) = xi (1 - b.c), given d = c - b (accurately).
+// Our formulation, in half angles of the arc's angle theta: sin(theta/2) = |d| / 2, cos(theta/2) = |b + c| / 2,
+//   sin(phi/2) = sqrt(xi) sin(theta/2),  cos(phi/2) = sqrt(cos^2(theta/2) + (1 - xi) sin^2(theta/2)),
+// and for the rest psi = theta - phi, without cancellation,
+//   sin(psi/2) = (1 - xi) sin^2(theta/2) / (sin(theta/2) cos(phi/2) + cos(theta/2) sin(phi/2)).
+// The point is measured from the nearer end (tangents t_b towards c, t_c towards b): cos(phi) b + sin(phi) t_b
+// or cos(psi) c + sin(psi) t_c. A tangent is the component of the other end orthogonal to this one, made
+// orthogonal once more after the subtraction: for nearly antipodal ends that component is as small as the ends'
+// distance from antipodal and carries their rounding. Written from b alone, as b (1 - xi h) + sqrt(xi h (2 - xi h)) t_b with
+// h = 1 - b.c, the far end of an arc between nearly antipodal b and c came out as -b: 2 - xi h cancels, and
+// c's small offset from -b was lost. Such arcs occur in fan triangles that are nearly hemispheres (x close to the
+// light's plane, above the triangle): on random lights seen from 1e-14..1e-2 of their size off their plane,
+// samples up to 1.6e-8 rad outside in double (test_polygon.cpp, SolidAngleSamplesLieInsideTheLightSeenFromCloseToItsPlane;
+// our remedy, issue 4).
 template <class T> Vec3<T> sample_arc(const Vec3<T>& b, const Vec3<T>& d, T xi) {
-  const T h = d.squaredNorm() / T(2);
-  const T one_minus_z = xi * h;
-  const T sin_theta = std::sqrt(std::max(T(0), one_minus_z * (T(2) - one_minus_z)));
-  const Vec3<T> t = safe_normalized(Vec3<T>(d + h * b));
-  return safe_normalized(Vec3<T>(b - one_minus_z * b + sin_theta * t));
+  const Vec3<T> c = b + d, sum = b + c;
+  T sh = d.norm() / T(2), ch = sum.norm() / T(2);
+  const T r = std::sqrt(sh * sh + ch * ch);  // 1 up to rounding (the chords of a unit b and c)
+  if (!(r > T(0)) || !std::isfinite(r)) return Vec3<T>::Zero();
+  sh /= r, ch /= r;
+  const T s_phi = std::sqrt(xi) * sh, c_phi = std::sqrt(ch * ch + (T(1) - xi) * sh * sh);
+  const T den = sh * c_phi + ch * s_phi;
+  const T s_psi = den > T(0) ? (T(1) - xi) * sh * sh / den : T(0), c_psi = ch * c_phi + sh * s_phi;
+  const T h = d.squaredNorm() / T(2);  // 1 - b.c
+  auto tangent = [](const Vec3<T>& at, const Vec3<T>& t) { return safe_normalized(Vec3<T>(t - t.dot(at) * at)); };
+  if (s_phi <= s_psi) {
+    const Vec3<T> tb = tangent(b, Vec3<T>(d + h * b));
+    return safe_normalized(Vec3<T>((T(1) - T(2) * s_phi * s_phi) * b + (T(2) * s_phi * c_phi) * tb));
+  }
+  const Vec3<T> tc = tangent(c, Vec3<T>(h * c - d));
+  return safe_normalized(Vec3<T>((T(1) - T(2) * s_psi * s_psi) * c + (T(2) * s_psi * c_psi) * tc));
 }
 
 template <class T> T pdf_polygon_solid_angle(const PolygonSolidAngleView<T>& v, const Vec3<T>& w) {

@@ -26,12 +26,12 @@
 //    density is known in closed form: with q(s) = g(s) (pi/2 - s)^(2/3) and e = pi/2 - s, the cut disk point
 //    has density (per unit disk area, per unit left-area) 1 / (X'(a) 2 sqrt(1 - X^2)) =
 //      1 / (2 ((2/3) g - g' e) sqrt(g) sqrt(2 - q))
-//    instead of 1. It is also not monotone at a = pi/2 (X(pi/2 +- 0) = -+4.6e-5: a fold, points with
-//    |d_x| < 4.6e-5 are reached twice) and the pieces' ends do not meet exactly (overlaps / gaps of relative
-//    width ~0.3% of 1 - |t_x| at the Case-2 seam and the top of the Case-3 lune). We therefore report the
-//    TRUE density of the implemented warp: the sum, over every piece and every branch of the quintic that
-//    reaches the direction, of its density. CutDiskInverse::kExact replaces the quintic by the exact inverse
-//    of A(X) (Boost.Math Newton iteration), for which the paper's densities hold exactly (Cases 1-2 uniform).
+//    instead of 1. As published it is also not monotone at a = pi/2 and its pieces' ends miss the cuts; our
+//    sampler rescales its argument and matches its ranges to the cuts (see "The quintic of Alg. 5" below), so
+//    the warp is injective and the pieces tile the projected cap. We report the TRUE density of the
+//    implemented warp (quintic factor included). CutDiskInverse::kExact replaces the quintic by the exact
+//    inverse of A(X) (Boost.Math Newton iteration), for which the paper's densities hold exactly (Cases 1-2
+//    uniform).
 //  * pdf is per solid angle: the paper's density p w.r.t. projected solid angle times cos = n.w.
 #pragma once
 
@@ -73,16 +73,6 @@ template <class T> T unit_disk_area_left_of(T x, T hh) {
   return x >= T(0) ? kPi<T> - right_of_abs : right_of_abs;
 }
 
-// The quintic g of Alg. 5 (Horner) and its derivative.
-template <class T> T quintic_g(T s) {
-  return (((((T(-0.0079908617) * s + T(0.0238255409)) * s - T(0.0283903598)) * s + T(0.0198450184)) * s -
-           T(0.0574433620)) * s + T(0.7400712465));
-}
-template <class T> T quintic_g_prime(T s) {
-  return ((((T(5) * T(-0.0079908617) * s + T(4) * T(0.0238255409)) * s - T(3) * T(0.0283903598)) * s +
-           T(2) * T(0.0198450184)) * s - T(0.0574433620));
-}
-
 // A point's abscissa in the unit disk with its half-height sqrt(1 - x^2), computed without cancellation.
 template <class T> struct CutDiskX {
   T x = T(0);
@@ -108,9 +98,56 @@ template <class T> T solve_cut_disk_angle(T target) {
       guess, T(0), kPi<T> / T(2), std::numeric_limits<T>::digits - 2, iterations);
 }
 
-// Density factor of the quintic at distance e = pi/2 - |a - pi/2| from the nearest end of the area range
-// (derived above): 1 / (2 ((2/3) g - g' e) sqrt(g) sqrt(2 - q)), q = g e^(2/3).
-// Its inverse with q = g(s) e^(2/3) already known (the sampler has it: one cube root per sample, not two).
+// ---- The quintic of Alg. 5, as published and as the sampler uses it ------------------------------------------
+//
+// In terms of e = pi/2 - |A| (the area between the point and the nearer end of the disk), Alg. 5 is
+//   |d_x| = 1 - q(e),   q(e) = g(pi/2 - e) e^(2/3),   sign(d_x) = sign(A).
+// Its constants give q(pi/2) = g(0) (pi/2)^(2/3) = 1.0000463 instead of 1: at A = 0 the published warp jumps
+// from d_x = +4.63e-5 (A -> 0-) to -4.63e-5 (A -> 0+), so a strip |d_x| < 4.63e-5 is reached twice (a fold of
+// the warp in u0), and a piece whose left-area range ends at the exact area of its cut (A_D, A_E' of Alg. 2-4)
+// ends up to ~1e-4 of the cut's width before or beyond the cut, because the quintic's abscissa there differs
+// from the exact one by up to 4.6e-5. Measured with the published form and the exact density of the warp
+// (warpcheck validate, double, 1e7 samples, 2026-12-01): the Case-3 estimator E[cos/pdf; hit] was 1.1e-4 low
+// (a sliver at the top of the lune never sampled), the Case-2 pieces overlapped at their seam, and the battery's
+// quadrature could not resolve the fold's thin strip of double density (pdf-integral 1.5e-6 low in Case 1,
+// although the density integrates to 1 - 1.0e-11 with the strip as a breakpoint).
+//
+// Our sampler therefore keeps the paper's g and evaluates Alg. 5 at a rescaled argument (our change, not in the
+// paper): e' = kappa e with kappa = e0 / (pi/2), where q(e0) = 1, so the two halves meet at d_x = 0 (no fold);
+// and each piece's left-area range ends where the quintic's abscissa is exactly the piece's cut (solved once per
+// light, `quintic_left_area`), so the pieces tile the projected cap exactly. The warp is then continuous and
+// injective, the density (reported exactly, see the header comment) is unchanged up to the factor kappa, and the
+// paper's Alg. 2-4 and 6 are otherwise as published. The paper's fit itself (its 4.6e-5) is measured on
+// `paper_quintic_x`, untouched; the rescaled fit's own error is measured by ProjectedCapQuintic.
+// RescaledFitErrorAgainstTheExactInverse.
+//
+// e0 solves g(pi/2 - e) e^(2/3) = 1 (Newton in long double; the test ProjectedCapQuintic.
+// RescaledHalvesMeetAtTheCentre recomputes it).
+template <class T> constexpr T kQuinticE0 = T(1.57070406662117638809L);
+template <class T> constexpr T kQuinticKappa = kQuinticE0<T> / (kPi<T> / T(2));
+
+// The quintic g of Alg. 5 (Horner) and its derivative.
+template <class T> T quintic_g(T s) {
+  return (((((T(-0.0079908617) * s + T(0.0238255409)) * s - T(0.0283903598)) * s + T(0.0198450184)) * s -
+           T(0.0574433620)) * s + T(0.7400712465));
+}
+template <class T> T quintic_g_prime(T s) {
+  return ((((T(5) * T(-0.0079908617) * s + T(4) * T(0.0238255409)) * s - T(3) * T(0.0283903598)) * s +
+           T(2) * T(0.0198450184)) * s - T(0.0574433620));
+}
+
+// Alg. 5 exactly as published: d_x for the left-area a in [0, pi] (the paper's A = a - pi/2).
+template <class T> T paper_quintic_x(T left_area) {
+  const T a = std::clamp(left_area, T(0), kPi<T>);
+  const T e = std::min(a, kPi<T> - a);
+  const T m = T(1) - quintic_g(kPi<T> / T(2) - e) * cube_root(e * e);
+  return a >= kPi<T> / T(2) ? m : -m;
+}
+
+// Inverse of the density factor of the quintic per unit of its own argument e, at s = pi/2 - e with
+// q = g(s) e^(2/3) already known (derived above: the strip at x has area 2 sqrt(1 - x^2) |dx/de|, and
+// dx/de = (2/3) g e^(-1/3) - g' e^(2/3)): 2 ((2/3) g - g' e) sqrt(g) sqrt(2 - q) (the e^(-1/3) cancels against
+// sqrt(1 - x^2) = sqrt(q (2 - q)) = e^(1/3) sqrt(g (2 - q))).
 template <class T> T quintic_inverse_density(T s, T e, T q) {
   const T g = quintic_g(s), gp = quintic_g_prime(s);
   return T(2) * (T(2) / T(3) * g - gp * e) * std::sqrt(g * std::max(T(0), T(2) - q));
@@ -119,19 +156,22 @@ template <class T> T quintic_density(T s, T e) {
   return T(1) / quintic_inverse_density(s, e, quintic_g(s) * std::cbrt(e * e));
 }
 
-// SampleCutUnitDisk (Alg. 5), abscissa only: the point whose left-area is `left_area` in [0, pi].
+// SampleCutUnitDisk (Alg. 5), abscissa only: the point whose left-area is `left_area` in [0, pi] (exactly for
+// kExact; for kQuintic the rescaled quintic above, whose density per unit left-area is 1 / (kappa times the
+// inverse factor of quintic_inverse_density)).
 template <class T, CutDiskInverse M> CutDiskX<T> sample_cut_unit_disk_x(T left_area) {
   const T a = std::clamp(left_area, T(0), kPi<T>);
   const T e = std::min(a, kPi<T> - a);  // pi/2 - |A| of Alg. 5, without cancellation near the ends
   const bool positive = a >= kPi<T> / T(2);
   CutDiskX<T> out;
   if constexpr (M == CutDiskInverse::kQuintic) {
-    const T s = kPi<T> / T(2) - e;  // |A|
-    const T q = quintic_g(s) * cube_root(e * e);
-    const T m = T(1) - q;  // |d_x| before the sign (negative inside the fold near a = pi/2)
+    const T er = kQuinticKappa<T> * e;  // the rescaled argument: er <= e0, so q <= 1 and no fold
+    const T s = kPi<T> / T(2) - er;
+    const T q = std::min(T(1), quintic_g(s) * cube_root(er * er));
+    const T m = T(1) - q;  // |d_x|
     out.x = positive ? m : -m;
-    out.half_height = std::sqrt(std::max(T(0), q * (T(2) - q)));  // sqrt(1 - m^2) = sqrt((1 - m)(1 + m))
-    out.inv_density = quintic_inverse_density(s, e, q);
+    out.half_height = std::sqrt(q * (T(2) - q));  // sqrt(1 - m^2) = sqrt((1 - m)(1 + m))
+    out.inv_density = kQuinticKappa<T> * quintic_inverse_density(s, er, q);  // d er / d a = kappa
   } else {
     const T theta = solve_cut_disk_angle(e);  // C(theta) = e: the area beyond |x| = cos(theta)
     out.x = positive ? std::cos(theta) : -std::cos(theta);
@@ -140,44 +180,33 @@ template <class T, CutDiskInverse M> CutDiskX<T> sample_cut_unit_disk_x(T left_a
   return out;
 }
 
-// Every left-area a in [0, pi] whose cut-disk abscissa is x (half-height hh), with the density there. The
-// exact inverse has one; the quintic has one per branch (a < pi/2, a >= pi/2) that reaches x, i.e. two inside
-// the fold |x| < X(pi/2 - 0). Returns the count.
+// The left-area a in [0, pi] whose cut-disk abscissa is x (half-height hh = sqrt(1 - x^2), passed for accuracy
+// near the disk's edge), with the density there; the inverse of sample_cut_unit_disk_x. One preimage: both
+// warps are injective (the rescaled quintic has no fold).
 template <class T> struct CutDiskPreimage {
   T left_area;
   T density;
 };
-template <class T, CutDiskInverse M> int cut_disk_preimages(T x, T hh, std::array<CutDiskPreimage<T>, 2>& out) {
+template <class T, CutDiskInverse M> CutDiskPreimage<T> cut_disk_preimage(T x, T hh) {
   if constexpr (M == CutDiskInverse::kExact) {
-    out[0] = {unit_disk_area_left_of(x, hh), T(1)};
-    return 1;
+    return {unit_disk_area_left_of(x, hh), T(1)};
   } else {
-    // Branch a >= pi/2: x = 1 - q(s); branch a < pi/2: x = -(1 - q(s)); q decreases from q(0) = 1.0000463 to 0.
-    // Solve q = target in t = e^(1/3) (q = g(pi/2 - t^3) t^2 is smooth in t, so Newton converges near the
-    // disk's edge where dX/da is infinite).
-    const T t_max = std::cbrt(kPi<T> / T(2));
-    const T q0 = quintic_g(T(0)) * t_max * t_max;
-    int n = 0;
-    for (int branch = 0; branch < 2; ++branch) {
-      const bool positive = branch == 0;
-      // 1 - x for the positive branch, 1 + x for the negative one; from hh when that is more accurate.
-      const T ax = positive ? x : -x;
-      T target = ax > T(0.5) ? hh * hh / (T(1) + ax) : T(1) - ax;
-      if (!(target <= q0)) continue;
-      target = std::max(target, T(0));
-      const T guess = std::min(std::sqrt(target / quintic_g(kPi<T> / T(2))), t_max);
-      std::uintmax_t iterations = 60;
-      const T t = boost::math::tools::newton_raphson_iterate(
-          [target](T t) {
-            const T t3 = t * t * t, s = kPi<T> / T(2) - t3;
-            const T g = quintic_g(s), gp = quintic_g_prime(s);
-            return std::make_pair(g * t * t - target, t * (T(2) * g - T(3) * t3 * gp));
-          },
-          guess, T(0), t_max, std::numeric_limits<T>::digits - 2, iterations);
-      const T e = t * t * t, s = kPi<T> / T(2) - e;
-      out[n++] = {positive ? kPi<T> - e : e, quintic_density(s, e)};
-    }
-    return n;
+    // q = 1 - |x|, from hh when that is more accurate; solve q = g(pi/2 - t^3) t^2 for t = er^(1/3) (smooth in
+    // t, so Newton converges near the disk's edge where dx/da is infinite), t in [0, e0^(1/3)].
+    const T ax = std::abs(x);
+    const T target = std::clamp(ax > T(0.5) ? hh * hh / (T(1) + ax) : T(1) - ax, T(0), T(1));
+    const T t_max = std::cbrt(kQuinticE0<T>);
+    const T guess = std::min(std::sqrt(target / quintic_g(kPi<T> / T(2))), t_max);
+    std::uintmax_t iterations = 60;
+    const T t = boost::math::tools::newton_raphson_iterate(
+        [target](T t) {
+          const T t3 = t * t * t, s = kPi<T> / T(2) - t3;
+          const T g = quintic_g(s), gp = quintic_g_prime(s);
+          return std::make_pair(g * t * t - target, t * (T(2) * g - T(3) * t3 * gp));
+        },
+        guess, T(0), t_max, std::numeric_limits<T>::digits - 2, iterations);
+    const T er = t * t * t, e = er / kQuinticKappa<T>;
+    return {x >= T(0) ? kPi<T> - e : e, quintic_density(kPi<T> / T(2) - er, er) / kQuinticKappa<T>};
   }
 }
 
@@ -192,6 +221,9 @@ template <class T> struct ProjectedCapView {
   T r_x = T(0), r_y = T(0), r_z = T(0), c_x = T(0), c_z = T(0), t_x = T(0), t_y = T(0), v = T(0);
   // Pieces: ellipse (Cases 1-2, u0 in [0, tau)), mirrored disk (Case 2, u0 in [tau, 1]), lune (Case 3).
   T area_e = T(0), area_e_unit = T(0), area_d = T(0), total = T(0), tau = T(0);
+  // The left-areas at which the rescaled quintic reaches the cuts exactly (Cases 2-3; see "The quintic of
+  // Alg. 5" above): X(quintic_area_e_unit) = X_t for the ellipse, X(quintic_area_d) = -t_x for the disk.
+  T quintic_area_e_unit = T(0), quintic_area_d = T(0);
   // Case 3: z scale k = (c_z + r_z) / t_y, c_z + r_z and r_z - c_z.
   T k = T(0), top = T(0), rz_minus_cz = T(0);
 
@@ -242,10 +274,14 @@ template <class T> ProjectedCapView<T> make_projected_cap_view(const SphereLight
     p.t_x = v / p.w_dx;                                       // w_dx >= v > 0 here
     p.t_y = std::sqrt(chord2) / p.w_dx;
     p.area_d = cut_disk_area_from_angle(std::atan2(std::sqrt(chord2), v));  // pi/2 - A(t_x)
+    p.quintic_area_d = cut_disk_preimage<T, CutDiskInverse::kQuintic>(-p.t_x, p.t_y).left_area;
     if (h >= T(0)) {
       // Case 2 (Alg. 2). A_E' = pi/2 + A(X_t) = pi - C(theta_E), X_t = cos(theta_E) = v h / (r_y w_dx).
       p.which_case = 2;
       p.area_e_unit = kPi<T> - cut_disk_area_from_angle(std::atan2(std::sqrt(chord2), v * h));
+      // X_t and its half-height sqrt(1 - X_t^2) (header comment).
+      p.quintic_area_e_unit =
+          cut_disk_preimage<T, CutDiskInverse::kQuintic>(v * h / (ry * p.w_dx), std::sqrt(chord2) / (ry * p.w_dx)).left_area;
       p.area_e = p.r_x * p.r_y * p.area_e_unit;
       p.total = p.area_e + p.area_d;
       p.tau = p.area_e / p.total;
@@ -339,52 +375,59 @@ template <class T> bool local_to_disk(const ProjectedCapView<T>& p, int piece, c
   return std::abs(dy) <= hh && std::isfinite(area_factor) && area_factor > T(0);
 }
 
-// The pieces of a view, with their u0 ranges and left-area maps a = alpha + beta u0.
+// The pieces of a view, with their u0 ranges and left-area maps a = alpha + beta u0. With the exact inverse these
+// are Alg. 2-4's: ellipse a = u0 (A_E + A_D) / A_E * A_E' = u0 A_E' / tau, disk a = (1 - u0) A_D / (1 - tau)
+// (= total (1 - u0)), lune a = (1 - u0) A_D. With the quintic the same maps end at the left-areas where the
+// quintic reaches the cuts (quintic_area_*), so that the pieces meet exactly; tau is the same.
 template <class T> struct Piece {
   int kind;
   T u_lo, u_hi, alpha, beta;
 };
-template <class T> int pieces(const ProjectedCapView<T>& p, std::array<Piece<T>, 2>& out) {
+template <class T, CutDiskInverse M> int pieces(const ProjectedCapView<T>& p, std::array<Piece<T>, 2>& out) {
+  constexpr bool q = M == CutDiskInverse::kQuintic;
   switch (p.which_case) {
     case 1: out[0] = {0, T(0), T(1), T(0), kPi<T>}; return 1;
     case 2: {
       int n = 0;
-      // Alg. 2: ellipse a = u0 (A_E + A_D) / A_E * A_E' = u0 total / (r_x r_y); disk a = total (1 - u0).
-      if (p.area_e > T(0)) out[n++] = {0, T(0), p.tau, T(0), p.total / (p.r_x * p.r_y)};
-      out[n++] = {1, p.tau, T(1), p.total, -p.total};
+      if (p.area_e > T(0)) {
+        const T ae = q ? p.quintic_area_e_unit : p.area_e_unit;
+        out[n++] = {0, T(0), p.tau, T(0), q ? ae / p.tau : p.total / (p.r_x * p.r_y)};
+      }
+      const T ad = q ? p.quintic_area_d / (T(1) - p.tau) : p.total;
+      out[n++] = {1, p.tau, T(1), ad, -ad};
       return n;
     }
-    case 3: out[0] = {2, T(0), T(1), p.area_d, -p.area_d}; return 1;
+    case 3: {
+      const T ad = q ? p.quintic_area_d : p.area_d;
+      out[0] = {2, T(0), T(1), ad, -ad};
+      return 1;
+    }
     default: return 0;
   }
 }
 
-// Density (per projected solid angle) of local direction w: the sum over pieces and quintic branches.
+// Density (per projected solid angle) of local direction w.
 // Optionally returns the first preimage (u0, u1).
+// The pieces tile the projected cap, so at most one reaches w, except on the seam (measure zero) where the
+// first one is taken.
 template <class T, CutDiskInverse M> T pdf_local(const ProjectedCapView<T>& p, const Vec3<T>& w, Vec2<T>* u = nullptr) {
   std::array<Piece<T>, 2> ps{};
-  const int n = pieces(p, ps);
-  T sum = T(0);
-  bool found = false;
+  const int n = pieces<T, M>(p, ps);
   for (int i = 0; i < n; ++i) {
     const Piece<T>& pc = ps[i];
     T dx, dy, hh, area;
     if (!local_to_disk(p, pc.kind, w, dx, dy, hh, area)) continue;
-    std::array<CutDiskPreimage<T>, 2> pre;
-    const int m = cut_disk_preimages<T, M>(dx, hh, pre);
+    const CutDiskPreimage<T> pre = cut_disk_preimage<T, M>(dx, hh);
     const T a_lo = std::min(pc.alpha + pc.beta * pc.u_lo, pc.alpha + pc.beta * pc.u_hi);
     const T a_hi = std::max(pc.alpha + pc.beta * pc.u_lo, pc.alpha + pc.beta * pc.u_hi);
-    for (int j = 0; j < m; ++j) {
-      if (pre[j].left_area < a_lo || pre[j].left_area > a_hi) continue;
-      sum += pre[j].density / (std::abs(pc.beta) * area);
-      if (u && !found) {
-        found = true;
-        (*u)[0] = std::clamp((pre[j].left_area - pc.alpha) / pc.beta, pc.u_lo, pc.u_hi);
-        (*u)[1] = hh > T(0) ? std::clamp((dy / hh + T(1)) / T(2), T(0), T(1)) : T(0.5);
-      }
+    if (pre.left_area < a_lo || pre.left_area > a_hi) continue;
+    if (u) {
+      (*u)[0] = std::clamp((pre.left_area - pc.alpha) / pc.beta, pc.u_lo, pc.u_hi);
+      (*u)[1] = hh > T(0) ? std::clamp((dy / hh + T(1)) / T(2), T(0), T(1)) : T(0.5);
     }
+    return pre.density / (std::abs(pc.beta) * area);
   }
-  return sum;
+  return T(0);
 }
 
 }  // namespace projected_cap_detail
@@ -398,22 +441,14 @@ DirectionSample<T> sample_projected_spherical_cap(const ProjectedCapView<T>& p, 
   if (!std::isfinite(u[0]) || !std::isfinite(u[1])) return DirectionSample<T>::none(NoSample::kNonFinite);
   const T u0 = std::clamp(u[0], T(0), T(1)), u1 = std::clamp(u[1], T(0), T(1));
   std::array<Piece<T>, 2> ps{};
-  const int n = pieces(p, ps);
+  const int n = pieces<T, M>(p, ps);
   int i = 0;
   while (i + 1 < n && u0 >= ps[i].u_hi) ++i;  // Alg. 2's threshold xi_0 < A_E / (A_E + A_D)
   const Piece<T>& pc = ps[i];
   const CutDiskX<T> d = sample_cut_unit_disk_x<T, M>(pc.alpha + pc.beta * u0);  // Alg. 5
   const T dy = (T(2) * u1 - T(1)) * d.half_height;
   const Local<T> loc = disk_to_local(p, pc.kind, d.x, dy, d.inv_density * std::abs(pc.beta));
-  T pdf_proj = loc.pdf_proj;
-  if constexpr (M == CutDiskInverse::kQuintic) {
-    // Where another piece or the other branch of the quintic also reaches this direction (the fold at
-    // |d_x| < 4.7e-5 and the Case-2 seam within 4.7e-5 of t_x), the density is the sum: recompute it.
-    const bool near_fold = std::abs(d.x) < T(5e-5);
-    const bool near_seam = p.which_case == 2 && std::abs(loc.w.x() - p.t_x) < T(5e-5);
-    if (near_fold || near_seam) pdf_proj = pdf_local<T, M>(p, loc.w);
-  }
-  const T pdf = pdf_proj * loc.w.z();
+  const T pdf = loc.pdf_proj * loc.w.z();
   if (!(pdf > T(0)) || !std::isfinite(pdf)) return DirectionSample<T>::none(NoSample::kOnSilhouette);
   DirectionSample<T> s;
   s.direction = renormalized(p.to_world(loc.w));
@@ -441,8 +476,7 @@ T pdf_projected_spherical_cap(const SphereLightGeometry<T>& g, const Vec3<T>& w)
   return pdf_projected_spherical_cap<T, M>(make_projected_cap_view(g), w);
 }
 
-// Inverse map: the primary sample (u0, u1) that the warp with inverse M maps to w (the first one, where the
-// quintic's fold or seam reaches w twice). False outside the support. With M = kExact applied to samples of
+// Inverse map: the primary sample (u0, u1) that the warp with inverse M maps to w. False outside the support. With M = kExact applied to samples of
 // the quintic warp, u0 measures the quintic's error in primary sample space.
 template <class T, CutDiskInverse M = CutDiskInverse::kQuintic>
 bool invert_projected_spherical_cap(const ProjectedCapView<T>& p, const Vec3<T>& w, Vec2<T>& u) {
@@ -452,11 +486,17 @@ bool invert_projected_spherical_cap(const ProjectedCapView<T>& p, const Vec3<T>&
   return projected_cap_detail::pdf_local<T, M>(p, wl, &u) > T(0);
 }
 
-// A cap containing every direction the sampler returns: the light's cap, widened by 2% of its 1 - cos for the
-// quintic's overshoot at the Case-2 seam and the top of the Case-3 lune (relative ~0.3% of the cut width).
+// A cap containing every direction the sampler returns: the light's cap, its angular radius widened by 64 eps_T
+// for rounding. The pieces tile the light's projection exactly (also with the quintic: its ranges end at the
+// cuts), so no more is needed; and no more is wanted: the battery's quadrature over this cap must see the support
+// reach the cap's edge (an earlier 2% widening of 1 - cos left the Case-3 sliver's support a thin band inside the
+// cap, which the quadrature missed: pdf-integral 2.75e-4 low on case3-sliver, double).
 template <class T> Cap<T> projected_cap_bounding_cap(const ProjectedCapView<T>& p) {
   Cap<T> c = p.sphere.cap();
-  c.one_minus_cos = std::min(T(2), c.one_minus_cos * T(1.02));
+  const T delta = T(64) * std::numeric_limits<T>::epsilon();  // radians
+  const T omc = c.one_minus_cos;
+  // 1 - cos(theta + delta) = omc + sin(theta) delta + cos(theta) delta^2 / 2 (cos <= 1 bounds the last term).
+  c.one_minus_cos = std::min(T(2), omc + std::sqrt(omc * (T(2) - omc)) * delta + delta * delta / T(2));
   return c;
 }
 

@@ -33,7 +33,9 @@ Maximises an error measure with multi-start Nelder-Mead in long double and repor
   --json FILE          write the result there (atomically) instead of to stdout
   --list               list the searches with their parameter boxes and exit
   --evaluate FILE      print the objective of --search at the input recorded in FILE (a result, checkpoint
-                       or data/worst-cases record of a search with the same parameters) and exit
+                       or data/worst-cases record of a search with the same parameters) and exit; with --json,
+                       also write FILE's record re-evaluated with the current kernels there (its error, the
+                       last history entry, kernel_version and command updated; evaluations and chains kept)
 
 SIGINT/SIGTERM stop the run early; the checkpoint and result are still written. Exit status: 0 done,
 1 runtime error (e.g. unreadable checkpoint), 2 bad arguments.
@@ -130,7 +132,16 @@ int worst_case_main(const std::vector<std::string>& args) {
     for (std::size_t i = 0; same && i < search->parameters.size(); ++i) same = from->parameters[i].name == search->parameters[i].name;
     if (!same) throw UsageError(evaluate + " holds an input of '" + r.search + "', whose parameters differ from '" + name + "'s");
     if (r.best_x.empty()) throw UsageError(evaluate + " holds no input");
-    std::printf("%s at the input of %s: %.6Le\n", name.c_str(), evaluate.c_str(), search->objective(r.best_x));
+    const long double value = search->objective(r.best_x);
+    std::printf("%s at the input of %s: %.6Le\n", name.c_str(), evaluate.c_str(), value);
+    if (!json.empty()) {
+      r.search = name;
+      r.best_f = value;
+      if (!r.history.empty()) r.history.back().best_f = value;
+      r.kernel_version = source_version();
+      r.command = joined("warpcheck worst-case", args);
+      write_file_atomically(json, to_json(r, &*search));
+    }
     return 0;
   }
 

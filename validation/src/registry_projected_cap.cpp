@@ -104,61 +104,31 @@ template <class T> SphereLightGeometry<T> cast(const SphereLightGeometry<Real>& 
           SphereLight<T>{g.light.center.cast<T>(), T(g.light.radius)}};
 }
 
-// Bisection for the u0 where a monotone function of u0 crosses zero (f(lo), f(hi) of opposite signs).
-template <class F> Real bisect(F f, Real lo, Real hi) {
-  const bool lo_neg = f(lo) < 0;
-  for (int i = 0; i < 200 && hi - lo > 1e-15L; ++i) {
-    const Real mid = (lo + hi) / 2;
-    ((f(mid) < 0) == lo_neg ? lo : hi) = mid;
-  }
-  return (lo + hi) / 2;
-}
-
 }  // namespace
 
-// Kinks in u0 of the warp (see the header comment of projected_cap.h): the Case-2 threshold tau, and for the
-// quintic the bands where the warp reaches a direction twice (the fold at left-area pi/2, the Case-2 seam). The
-// battery's Jacobian check assumes an injective warp, so inside those bands it would compare the summed density
-// with one branch's area element; the bands are listed as kinks every 4e-6 (the check skips points within 5e-6
-// of a kink). The band edges are found by bisection on the long double warp; u0 enters the abscissa alone.
+// Kinks in u0 of the warp (see the header comment of projected_cap.h): the Case-2 threshold tau, where the warp
+// passes from the ellipse piece to the mirrored disk (continuous there, but its derivative jumps), and for the
+// quintic the u0 where a piece's left-area passes pi/2: the rescaled quintic's halves meet there with equal
+// slopes, but its density factor depends on min(a, pi - a) and has a kink (tanh-sinh quadrature across it was
+// 2.2e-5 off on the tiny-straddling ellipse piece). With the pieces matched to the cuts neither inverse reaches
+// a direction twice, so there are no bands of double coverage; the function keeps returning (a, b) pairs,
+// a == b for a single kink.
 template <CutDiskInverse M>
 std::vector<std::pair<Real, Real>> projected_cap_bands(const SphereLightGeometry<Real>& g) {
   using namespace projected_cap_detail;
   std::vector<std::pair<Real, Real>> bands;
   const ProjectedCapView<Real> p = make_projected_cap_view(g);
   if (!p.valid()) return bands;
-  std::array<Piece<Real>, 2> ps;
-  const int n = pieces(p, ps);
   if (p.which_case == 2) bands.push_back({p.tau, p.tau});
   if constexpr (M == CutDiskInverse::kQuintic) {
-    auto x_of = [&](const Piece<Real>& pc, Real u0) {  // the local abscissa w_x of u0 in piece pc
-      const CutDiskX<Real> d = sample_cut_unit_disk_x<Real, M>(pc.alpha + pc.beta * u0);
-      return disk_to_local(p, pc.kind, d.x, Real(0), Real(1)).w.x();
-    };
+    std::array<Piece<Real>, 2> ps;
+    const int n = pieces<Real, M>(p, ps);
     for (int i = 0; i < n; ++i) {
-      const Piece<Real>& pc = ps[i];
-      // Fold: the piece's left-area range contains pi/2; the band is where |d_x| < |X(pi/2 - 0)|.
-      const Real a0 = pc.alpha + pc.beta * pc.u_lo, a1 = pc.alpha + pc.beta * pc.u_hi;
-      const Real half = kPi<Real> / 2;
-      if (std::min(a0, a1) < half && std::max(a0, a1) > half) {
-        const Real xf = std::abs(sample_cut_unit_disk_x<Real, M>(half).x);
-        const Real uc = (half - pc.alpha) / pc.beta;
-        auto dx = [&](Real u) { return sample_cut_unit_disk_x<Real, M>(pc.alpha + pc.beta * u).x; };
-        const Real ua = bisect([&](Real u) { return dx(u) + xf; }, pc.u_lo, uc);
-        const Real ub = bisect([&](Real u) { return dx(u) - xf; }, uc, pc.u_hi);
-        bands.push_back({std::min(ua, ub), std::max(ua, ub)});
-      }
-    }
-    if (p.which_case == 2 && n == 2) {
-      // Seam: the ellipse ends at x_E, the disk begins at x_D; each piece's band is where it reaches the
-      // other's range of w_x.
-      const Real xe = x_of(ps[0], p.tau), xd = x_of(ps[1], p.tau);
-      const Real lo = std::min(xe, xd) - 1e-12L, hi = std::max(xe, xd) + 1e-12L;
-      const Real ue = bisect([&](Real u) { return x_of(ps[0], u) - lo; }, 0, p.tau);
-      const Real ud = bisect([&](Real u) { return x_of(ps[1], u) - hi; }, p.tau, 1);
-      bands.push_back({ue, ud});
+      const Real u = (kPi<Real> / 2 - ps[i].alpha) / ps[i].beta;
+      if (u > ps[i].u_lo && u < ps[i].u_hi) bands.push_back({u, u});
     }
   }
+  std::sort(bands.begin(), bands.end());
   return bands;
 }
 
@@ -184,7 +154,12 @@ template <CutDiskInverse M> std::vector<Real> projected_cap_kinks(const SphereLi
 //   m1_in  = E[X 1(w in the light)]   (what a renderer computes: a ray outside the cap misses the light)
 //   m2     = E[X^2]
 template <class T, CutDiskInverse M> LambertianMoments projected_cap_lambertian_moments(const SphereLightGeometry<Real>& g, Real tol) {
-  boost::math::quadrature::tanh_sinh<Real> ts(12);
+  // min_complement 1e-18: no abscissa closer than that to an end of [0, 1]. Boost's default (4 * min of long
+  // double) puts u0 within ~1e-4900 of a piece's end, where it rounds onto the end itself (a sample on the
+  // silhouette, declined, or on the next piece); for the exact inverse in long double on tiny-straddling that
+  // made tanh_sinh throw ("evaluated your function at a singular point"). The integrands are bounded, so the
+  // skipped end slivers weigh at most 2e-18 of the integral.
+  boost::math::quadrature::tanh_sinh<Real> ts(12, Real(1e-18));
   const ProjectedCapView<T> p = make_projected_cap_view(cast<T>(g));
   const SphereView<Real> sv = make_sphere_view(g);
   const Cap<Real> light = sv.cap();
@@ -192,7 +167,7 @@ template <class T, CutDiskInverse M> LambertianMoments projected_cap_lambertian_
   // A direction rounded to T lies up to ~eps(T) off the light's boundary: chord^2 slack relative to the cap's.
   const Real in_slack = 16 * Real(std::numeric_limits<T>::epsilon()) / std::sqrt(2 * light.one_minus_cos);
   std::array<projected_cap_detail::Piece<T>, 2> ps{};
-  const int count = projected_cap_detail::pieces(p, ps);
+  const int count = projected_cap_detail::pieces<T, M>(p, ps);
   std::vector<Real> cuts;
   for (const auto& [a, b] : projected_cap_bands<M>(g)) cuts.push_back(a), cuts.push_back(b);
   LambertianMoments out;

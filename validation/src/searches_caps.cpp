@@ -36,7 +36,7 @@ Search quintic_search() {
   s.parameters = {{"A", 0, kPiL / 2, "offset area A of Alg. 5 (left-area pi/2 + A)"}};
   s.objective = [](std::span<const L> p) -> L {
     const L left = kPiL / 2 + p[0];
-    const L xq = sample_cut_unit_disk_x<L, CutDiskInverse::kQuintic>(left).x;
+    const L xq = paper_quintic_x<L>(left);  // the published fit, not the sampler's rescaled form
     const L xe = sample_cut_unit_disk_x<L, CutDiskInverse::kExact>(left).x;
     const L e = std::abs(xq - xe);
     return std::isfinite(e) ? e : kInf;

@@ -4,8 +4,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
+#include <random>
 #include <set>
 
+#include "warpcheck/polygon_error_analysis.h"
 #include "warpcheck/validation/searches.h"
 
 using namespace warpcheck::validation;
@@ -186,4 +189,43 @@ TEST(Searches, MergingShardsTakesTheWorstAndSumsTheWork) {
   }
   SearchRecord other = fresh("polygon-backward-k1");
   EXPECT_THROW(merge_records({shards[0], other}), std::runtime_error);
+}
+
+// The polygon-backward searches cover exactly the sectors real polygons have (Peters 2021 Sec. 3.6 searches
+// "test cases" of inner/outer ellipse, sector and target): every sector of random decentral triangles, rotated so
+// that s0 = (1, 0) and written in the search's parameters, is a valid point with the kernel's own backward error;
+// and the search's first worst case (7.8e-2, recorded before 2026-12-01), whose sector contains the direction
+// where the outer edge's great circle meets the horizon, is not a valid point.
+TEST(PolygonBackwardSearch, EverySectorOfARealPolygonIsAPointOfTheSearchAndNoOtherIs) {
+  using L = long double;
+  const Search s = *find_search("polygon-backward-k2");
+  std::mt19937_64 rng(7);
+  int checked = 0;
+  for (int trial = 0; trial < 2000; ++trial) {
+    const warpcheck::RandomSectorCase<L> c = warpcheck::random_decentral_case<L>(rng, 1e-2L);
+    const auto& sec = c.sector;
+    const L rot = std::atan2(sec.s0.y(), sec.s0.x());
+    const warpcheck::Vec2<L> s0 = sec.s0 / sec.s0.norm(), s1 = sec.s1 / sec.s1.norm();
+    const L angle = std::atan2(s0.x() * s1.y() - s0.y() * s1.x(), s0.dot(s1));
+    std::vector<L> p;
+    for (const auto* e : {&sec.inner, &sec.outer}) {
+      const L sign = e->nz < 0 ? -1 : 1;  // the ellipse of n and -n is the same: the search has n_z >= 0
+      const L nx = sign * e->nxy.x(), ny = sign * e->nxy.y(), nz = sign * e->nz;
+      p.push_back(std::atan2(std::hypot(nx, ny), nz));
+      p.push_back(std::remainder(std::atan2(ny, nx) - rot, 2 * std::numbers::pi_v<L>));
+    }
+    p.push_back(angle * 180 / std::numbers::pi_v<L>);
+    p.push_back(c.target / sec.area);
+    if (!(p[4] <= 179.999L)) continue;
+    const L e = s.objective(p);
+    ASSERT_FALSE(std::isnan(e)) << "a real polygon's sector is outside the search, trial " << trial;
+    EXPECT_NEAR(e, warpcheck::decentral_backward_error(c, 2), 1e-12L + 1e-6L * e) << trial;
+    ++checked;
+  }
+  EXPECT_GT(checked, 1900);
+  // The old worst case (data/worst-cases/polygon-backward-k2.json before 2026-12-01, to 17 digits): still 7.8e-2
+  // without the constraint, which is what makes it NaN now.
+  const std::vector<L> old{1.5707963267948966L, -1.5720280146623582L, 1.5644003505118398L, -0.80375905809977888L,
+                           179.91251265643641L, 0.2705798324036342L};
+  EXPECT_TRUE(std::isnan(s.objective(old)));
 }

@@ -141,3 +141,32 @@ TEST(WorstCaseCli, EvaluatePrintsTheObjectiveAtARecordedInput) {
                               dir.path / "log")),
             2);
 }
+
+// --evaluate with --json re-records an input with the current kernels: a record whose error was tampered with
+// (halved) comes back with the true error at the same input, the rest of the record kept.
+TEST(WorstCaseCli, EvaluateWithJsonRewritesTheRecordWithTheCurrentError) {
+  const fs::path cli = cli_path();
+  ASSERT_FALSE(cli.empty());
+  TempDir dir;
+  const fs::path rec = fs::path(WARPCHECK_SOURCE_DIR) / "data" / "worst-cases" / "projected-cap-quintic.json";
+  SearchRecord r = record_from_json(slurp(rec));
+  const long double truth = r.best_f;
+  r.best_f /= 2;
+  if (!r.history.empty()) r.history.back().best_f /= 2;
+  {
+    std::ofstream f(dir.path / "tampered.json");
+    f << to_json(r);
+  }
+  ASSERT_EQ(wait_status(spawn({cli.string(), "worst-case", "--search", "projected-cap-quintic", "--evaluate",
+                               (dir.path / "tampered.json").string(), "--json", (dir.path / "fresh.json").string()},
+                              dir.path / "log", dir.path / "out")),
+            0)
+      << slurp(dir.path / "log");
+  const SearchRecord f = record_from_json(slurp(dir.path / "fresh.json"));
+  EXPECT_EQ(f.best_f, truth);
+  ASSERT_FALSE(f.history.empty());
+  EXPECT_EQ(f.history.back().best_f, truth);
+  EXPECT_EQ(f.best_x, r.best_x);
+  EXPECT_EQ(f.evaluations, r.evaluations);
+  EXPECT_NE(f.command.find("--evaluate"), std::string::npos);
+}

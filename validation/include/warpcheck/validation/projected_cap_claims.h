@@ -44,18 +44,20 @@ inline Real exact_inverse_of_A(Real a) {
   return (r.first + r.second) / 2;
 }
 
-// The paper's fit 1 - g(A) (pi/2 - A)^(2/3) (Alg. 5), evaluated through the kernel.
-inline Real quintic_inverse_of_A(Real a) {
+// The paper's fit 1 - g(A) (pi/2 - A)^(2/3) (Alg. 5 as published, paper_quintic_x), and the rescaled form the
+// sampler evaluates (sample_cut_unit_disk_x, kQuintic; see projected_cap.h).
+inline Real quintic_inverse_of_A(Real a) { return paper_quintic_x<Real>(kPi<Real> / 2 + a); }
+inline Real rescaled_quintic_inverse_of_A(Real a) {
   return sample_cut_unit_disk_x<Real, CutDiskInverse::kQuintic>(kPi<Real> / 2 + a).x;
 }
 
 struct QuinticError {
   Real max_error = 0, at = 0;
 };
-// max over A in [0, pi/2] of |X(A) - quintic(A)|: a grid of `grid` points, then Brent's method (Boost) around the
-// grid maximum and the endpoint A = 0 kept as a candidate.
-inline QuinticError quintic_max_error(int grid) {
-  auto err = [](Real a) { return std::abs(exact_inverse_of_A(a) - quintic_inverse_of_A(a)); };
+// max over A in [0, pi/2] of |X(A) - fit(A)|: a grid of `grid` points, then Brent's method (Boost) around the
+// grid maximum and the endpoint A = 0 kept as a candidate. fit: the paper's quintic by default.
+inline QuinticError quintic_max_error(int grid, Real (*fit)(Real) = quintic_inverse_of_A) {
+  auto err = [fit](Real a) { return std::abs(exact_inverse_of_A(a) - fit(a)); };
   QuinticError e;
   int best = 0;
   for (int i = 0; i <= grid; ++i) {
@@ -160,8 +162,8 @@ struct RoundTrip {
   Vec2<double> at = Vec2<double>::Zero();
   int checked = 0, skipped = 0, failures = 0;
 };
-// max |invert(sample(u)) - u| in double over n random u, skipping u0 within 1e-4 of the kinks/bands of
-// projected_cap_bands (Case-2 threshold; the quintic's fold and seam, where the warp reaches a direction twice).
+// max |invert(sample(u)) - u| in double over n random u, skipping u0 within 1e-4 of the kinks of
+// projected_cap_bands (the Case-2 threshold).
 template <CutDiskInverse M> RoundTrip round_trip(const SphereLightGeometry<Real>& gl, int n, std::uint64_t seed) {
   const SphereLightGeometry<double> g{ShadingPoint<double>{gl.shading.position.cast<double>(), gl.shading.normal.cast<double>()},
                                       SphereLight<double>{gl.light.center.cast<double>(), double(gl.light.radius)}};
@@ -192,10 +194,9 @@ template <CutDiskInverse M> RoundTrip round_trip(const SphereLightGeometry<Real>
 }
 
 // u0' = exact inverse (long double) of the quintic's sample at u0 (u0' depends on u0 only: the pieces and the
-// Case-3 warp act on the cut-disk abscissa alone). The KS distance of u0' from uniform is max |u0' - u0| where the
-// map is monotone (outside the quintic's fold, whose width 9e-5 in area is below this figure's resolution), measured
-// on a grid of `grid` points. Samples whose direction the exact warp does not reach (the quintic overshoots the top
-// of the Case-3 lune) count as u0' = 0 there (their exact preimage would lie beyond u0 = 0).
+// Case-3 warp act on the cut-disk abscissa alone). The map is monotone (both warps are injective and tile the same
+// pieces), so the KS distance of u0' from uniform is max |u0' - u0|, measured on a grid of `grid` points. A sample
+// the exact warp does not reach (a direction rounded just outside the light) counts as u0' = 0.
 inline Real round_trip_u0_deviation(const SphereLightGeometry<Real>& g, int grid) {
   const ProjectedCapView<Real> v = make_projected_cap_view(g);
   Real worst = 0;
