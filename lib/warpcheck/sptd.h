@@ -97,10 +97,20 @@ template <class T> Cap<T> pivot_transform_cap(const Cap<T>& c, const Vec3<T>& rp
   if (c.one_minus_cos >= T(2)) return Cap<T>{c.axis, T(2)};  // the whole sphere maps onto itself
   const Vec3<T>& wc = c.axis;
   // The plane through the origin, w_c and r_p (Fig. 3 (1)); any plane through w_c when r_p is parallel to it.
+  // Two Gram-Schmidt passes: with r_p nearly parallel to w_c one pass leaves a component along w_c of ~eps |r_p|,
+  // so t.w_c / |t| is rounding noise and the boundary points below lie off the sphere, where the anti-inversion
+  // form of g does not apply (found by fuzz_sptd_double: |t| = 2.1e-14, t.w_c / |t| = -6.1e-3, boundary points
+  // 1.1e-6 off the unit sphere, the image's 1 - cos off by 3.8e-5, issue 7). After the second pass t is orthogonal
+  // to w_c up to rounding; below the threshold it is noise, and every plane through w_c is one of symmetry.
+  // For a tiny pivot the squares of t's entries underflow (found by fuzz_sptd_double with |r_p| = 8e-153: t / |t|
+  // off unit length, the image's 1 - cos off by 2.4e-4, issue 7): stableNorm, and below min_T / eps_T (subnormal
+  // products lose their precision; |r_p| = 2e-308: 1 - cos off by 6e-9) any plane, as the pivot is negligible.
   Vec3<T> t = rp - rp.dot(wc) * wc;
-  const T tn = t.norm();
-  t = tn > T(64) * std::numeric_limits<T>::epsilon() * rp.norm() && tn > T(0) ? Vec3<T>(t / tn)
-                                                                               : Frame<T>::from_z(wc).x;
+  t -= t.dot(wc) * wc;
+  const T tn = t.stableNorm();
+  constexpr T e = std::numeric_limits<T>::epsilon();
+  t = tn > T(64) * e * rp.stableNorm() && tn > std::numeric_limits<T>::min() / e ? Vec3<T>(t / tn)
+                                                                                : Frame<T>::from_z(wc).x;
   const T omc = c.one_minus_cos;
   const T cos_a = T(1) - omc, sin_a = std::sqrt(std::max(T(0), omc * (T(2) - omc)));
   // Fig. 3 (2)-(3): the boundary points in that plane and their images.
