@@ -114,8 +114,9 @@ template <class T> Cap<T> pivot_transform_cap(const Cap<T>& c, const Vec3<T>& rp
   const T omc = c.one_minus_cos;
   const T cos_a = T(1) - omc, sin_a = std::sqrt(std::max(T(0), omc * (T(2) - omc)));
   // Fig. 3 (2)-(3): the boundary points in that plane and their images.
-  const Vec3<T> g1 = pivot_transform(Vec3<T>(cos_a * wc + sin_a * t), rp, k);
-  const Vec3<T> g2 = pivot_transform(Vec3<T>(cos_a * wc - sin_a * t), rp, k);
+  const Vec3<T> p1 = cos_a * wc + sin_a * t, p2 = cos_a * wc - sin_a * t;
+  const Vec3<T> g1 = pivot_transform(p1, rp, k);
+  const Vec3<T> g2 = pivot_transform(p2, rp, k);
   const Vec3<T> gc = pivot_transform(wc, rp, k);
   // Eq. 6 (in-plane bisector), robust for image caps of any size.
   const Vec3<T> sum = g1 + g2, diff = g1 - g2;
@@ -125,7 +126,18 @@ template <class T> Cap<T> pivot_transform_cap(const Cap<T>& c, const Vec3<T>& rp
     const Vec3<T> m = wc.cross(t).cross(diff);  // in the plane, orthogonal to g1 - g2
     axis = m / m.norm();
   }
-  if ((gc - axis).squaredNorm() > (g1 - axis).squaredNorm()) axis = -axis;  // g(w_c) lies inside g(C)
+  // g(w_c) lies inside g(C). That test compares distances of the order of the image's size, which are noise for an
+  // image below the resolution of T's directions (found by fuzz_sptd_double: an image of 5e-18 rad oriented as the
+  // whole sphere, density 4e-21 instead of 1.8e14, issue 7). But g stretches lengths on C by at most k / d_min^2
+  // (Eq. 4; d_min the distance from r_p to C: 1 - |r_p| if C contains r_p's direction, else that to the nearer
+  // boundary point, p1 or p2), so g(C) has diameter <= 2 alpha k / d_min^2; below pi/2 it cannot be the complement
+  // of the cap around the bisector (diameter >= pi): no flip there.
+  const T rn = rp.norm();
+  const bool contains_pivot = rn > T(0) && (rp / rn - wc).squaredNorm() <= T(2) * omc;
+  const T d_min = contains_pivot ? T(1) - rn : std::min((p1 - rp).norm(), (p2 - rp).norm());
+  const T alpha = T(2) * std::asin(std::min(T(1), std::sqrt(omc / T(2))));
+  const bool surely_small = T(2) * alpha * k < kPi<T> / T(2) * d_min * d_min;
+  if (!surely_small && (gc - axis).squaredNorm() > (g1 - axis).squaredNorm()) axis = -axis;
   // Eq. 7, as a chord length (1 - cos = |g_i - axis|^2 / 2) averaged over both boundary points.
   const T image_omc = std::min(T(2), ((g1 - axis).squaredNorm() + (g2 - axis).squaredNorm()) / T(4));
   return Cap<T>{axis, image_omc};
