@@ -138,8 +138,25 @@ template <class T> Cap<T> pivot_transform_cap(const Cap<T>& c, const Vec3<T>& rp
   const T alpha = T(2) * std::asin(std::min(T(1), std::sqrt(omc / T(2))));
   const bool surely_small = T(2) * alpha * k < kPi<T> / T(2) * d_min * d_min;
   if (!surely_small && (gc - axis).squaredNorm() > (g1 - axis).squaredNorm()) axis = -axis;
-  // Eq. 7, as a chord length (1 - cos = |g_i - axis|^2 / 2) averaged over both boundary points.
-  const T image_omc = std::min(T(2), ((g1 - axis).squaredNorm() + (g2 - axis).squaredNorm()) / T(4));
+  // Eq. 7, as a chord length (1 - cos = |g_i - axis|^2 / 2) averaged over both boundary points. Where the image
+  // circle is small (the image cap or its complement within 30 degrees) that chord is a difference of nearly equal
+  // unit vectors and loses eps / psi' relatively (found by fuzz_sptd_double: psi' = 2.5e-12, 1 - cos off by
+  // 3.3e-5, issue 7). There we use the distance formula of the inversion instead (derived here, not in the paper):
+  // g is the inversion about r_p of power k followed by the point reflection through r_p, so |g(p) - g(q)| =
+  // k |p - q| / (|p - r_p| |q - r_p|), and g1, g2 are the ends of a diameter of the image circle (which is
+  // symmetric about the plane); hence sin(psi'') = k sin(alpha) / (|p1 - r_p| |p2 - r_p|) for the smaller of the
+  // two caps the circle bounds, and 1 - cos(psi'') = s^2 / (1 + sqrt(1 - s^2)) without cancellation.
+  // (A boundary point can coincide with r_p in T when |r_p| is within an ulp of 1: then the formula is not used;
+  // found by fuzz_sptd_double under UBSan's float-divide-by-zero, issue 7.)
+  const T chord_denominator = (p1 - rp).norm() * (p2 - rp).norm();
+  const T s = chord_denominator > T(0) ? k * sin_a / chord_denominator : T(1);
+  T image_omc;
+  if (s < T(0.5)) {
+    const T small = s * s / (T(1) + std::sqrt((T(1) - s) * (T(1) + s)));
+    image_omc = axis.dot(g1) >= T(0) ? small : T(2) - small;
+  } else {
+    image_omc = std::min(T(2), ((g1 - axis).squaredNorm() + (g2 - axis).squaredNorm()) / T(4));
+  }
   return Cap<T>{axis, image_omc};
 }
 template <class T> Cap<T> pivot_transform_cap(const Cap<T>& c, const Vec3<T>& rp) {
