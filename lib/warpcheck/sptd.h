@@ -48,6 +48,7 @@
 #include <boost/math/tools/roots.hpp>
 
 #include "warpcheck/core.h"
+#include "warpcheck/projected_cap.h"  // cut_disk_area_from_angle
 #include "warpcheck/sphere.h"
 
 namespace warpcheck {
@@ -192,6 +193,7 @@ template <class T> struct CosineCapView {
   T cos_a = 0, sin_a = 0;      // cap half-angle alpha
   T cos_t = 0, sin_t = 0;      // angle t between the cap axis and n
   T xc = 0, A = 0, x0 = 0;     // ellipse centre and x semi-axis; x >= x0: full chord side
+  T seg0 = 0;                  // area of the unit disk right of x0, without cancellation (make_cosine_cap_view)
   bool ellipse_only = false;   // R = E (cap entirely above the horizon)
   T area = 0;                  // projected solid angle of (cap, upper hemisphere) = area of R
 
@@ -203,14 +205,20 @@ template <class T> struct CosineCapView {
     const T t = std::clamp((x - xc) / A, T(-1), T(1));
     return sin_a * A * (t * std::sqrt((T(1) - t) * (T(1) + t)) + std::asin(t) + kPi<T> / T(2));
   }
-  static T disk_cdf(T x) {
-    x = std::clamp(x, T(-1), T(1));
-    return x * std::sqrt((T(1) - x) * (T(1) + x)) + std::asin(x) + kPi<T> / T(2);
+  // Area of the unit disk right of x = cos(theta), theta in [0, pi]: C(theta) = theta - sin(theta) cos(theta) by
+  // projected_cap.h's cut_disk_area_from_angle (a series where that difference cancels) up to pi/2, pi - C(pi -
+  // theta) beyond. The area of the disk between x0 and x was the difference of two areas left of them, ~pi each,
+  // which leaves an absolute error of ~eps pi: relatively ~eps pi / area for a small cap straddling the horizon
+  // (found by fuzz_sptd_double: image cap of 1.4e-3 rad on the horizon, area 1.76e-9 off by 4e-7, issue 7).
+  static T disk_right_of_angle(T theta) {
+    return theta <= kPi<T> / T(2) ? cut_disk_area_from_angle(theta) : kPi<T> - cut_disk_area_from_angle(kPi<T> - theta);
   }
-  // Area of R with abscissa < x.
+  static T disk_right_of(T x) { return disk_right_of_angle(std::acos(std::clamp(x, T(-1), T(1)))); }
+  // Area of R with abscissa < x; the disk part between x0 and x as seg0 - (disk right of x).
   T cdf(T x) const {
-    if (cos_t >= T(0)) return ellipse_cdf(std::min(x, x0)) + (x > x0 ? disk_cdf(x) - disk_cdf(x0) : T(0));
-    return x > x0 ? std::max(T(0), (disk_cdf(x) - disk_cdf(x0)) - (ellipse_cdf(x) - ellipse_cdf(x0))) : T(0);
+    const T disk = x > x0 ? std::max(T(0), seg0 - disk_right_of(x)) : T(0);
+    if (cos_t >= T(0)) return ellipse_cdf(std::min(x, x0)) + disk;
+    return x > x0 ? std::max(T(0), disk - (ellipse_cdf(x) - ellipse_cdf(x0))) : T(0);
   }
   // Half-height of E at abscissa x (0 outside it).
   T ellipse_half_height(T x) const {
@@ -241,7 +249,14 @@ template <class T> CosineCapView<T> make_cosine_cap_view(const Cap<T>& cap, cons
   // x >= x0 <=> cos(alpha) - x sin(t) <= 0; clamped to +-2 (only comparisons with x in [-1, 1] matter).
   if (v.sin_t > T(0)) v.x0 = std::clamp(v.cos_a / v.sin_t, T(-2), T(2));
   else v.x0 = v.cos_a > T(0) ? T(2) : T(-2);
-  v.ellipse_only = v.cos_t >= T(0) && v.x0 >= v.xc + v.A;
+  // The disk's area right of x0 as a segment area (cdf): x0 itself is known to an absolute eps either way.
+  v.seg0 = v.x0 >= T(1) ? T(0) : v.x0 <= T(-1) ? kPi<T> : CosineCapView<T>::disk_right_of(v.x0);
+  // R = E exactly when the cap lies entirely above the horizon, alpha + t <= pi/2, i.e. cos(alpha) >= sin(t) (both
+  // angles in [0, pi/2] there). The test x0 >= x_c + A (= sin(t + alpha)) is equivalent only for cos(t) > 0: at
+  // cos(t) = 0 it reads x0 >= x_c, which holds up to rounding for any alpha (found by fuzz_sptd_double: a cap of
+  // half-angle 24 deg with its axis on the horizon, cos(t) = 5e-39, got the area of its degenerate ellipse, 2.5e-39,
+  // and a density of 3e40 instead of 1455, issue 7).
+  v.ellipse_only = v.cos_t >= T(0) && v.cos_a >= v.sin_t;
   v.area = v.ellipse_only ? kPi<T> * v.sin_a * v.A : v.cdf(T(1));
   if (!(v.area > T(0)) || !std::isfinite(v.area)) return v.reason = NoSample::kBelowHorizon, v;
   return v;
