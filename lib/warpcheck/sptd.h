@@ -421,6 +421,9 @@ template <class T> SptdCapView<T> make_sptd_cap_view(const SptdCapGeometry<T>& g
     if (!v.cosine.valid()) return v.reason = v.cosine.reason, v;
     v.base_integral = v.cosine.area / kPi<T>;
   }
+  // The normalised base density 1 / |g(C)| resp. 1 / area must be representable (as for sphere lights, sphere.h).
+  const T norm = v.sptd.base == SptdBase::kUniform ? v.image.solid_angle() : v.cosine.area;
+  if (!std::isfinite(T(1) / norm)) return v.reason = NoSample::kTooSmall, v;
   return v;
 }
 
@@ -441,7 +444,10 @@ template <class T> T pdf_sptd_cap(const SptdCapView<T>& v, const Vec3<T>& w) {
   if (!(len > T(0))) return T(0);
   const Vec3<T> wu = w / len;
   const T p = base_cap_pdf(v, pivot_transform(wu, v.sptd.pivot, v.k));
-  return p > T(0) ? p * pivot_jacobian(wu, v.sptd.pivot, v.k) : T(0);
+  // The product overflows for densities beyond T's range (a pivot within ~eps of the sphere, a tiny cap): no
+  // density rather than Inf (found by fuzz_sptd_float, issue 7).
+  const T pdf = p > T(0) ? p * pivot_jacobian(wu, v.sptd.pivot, v.k) : T(0);
+  return std::isfinite(pdf) ? pdf : T(0);
 }
 
 template <class T> DirectionSample<T> sample_sptd_cap(const SptdCapView<T>& v, const Vec2<T>& u) {
