@@ -443,6 +443,16 @@ template <class T> T pdf_sptd_cap(const SptdCapView<T>& v, const Vec3<T>& w) {
   const T len = w.norm();
   if (!(len > T(0))) return T(0);
   const Vec3<T> wu = w / len;
+  // 0 outside C, tested on C itself, not only through the image: in T the image cap can swallow C's complement,
+  // where its 1 - cos is within rounding of 2 (found by fuzz_sptd_double: |r_p| = 1 - 9e-13, a C of 120 deg whose
+  // image is the sphere minus a cap of ~1e-12 rad, stored as 1 - cos = 2: pdf > 0 at 0.45 rad outside C, issue 7).
+  // By the chord to the axis for C up to a hemisphere, to the antipode for larger C (whose complement's chord,
+  // 2 - (1 - cos), is then exact), each with a relative slack of 8 eps plus a chord of 4 eps for the rounding of
+  // unit directions; a relative slack on the chord to the axis would be ~1e-3 rad near the antipode in float.
+  const T e = std::numeric_limits<T>::epsilon(), omc = v.cap.one_minus_cos;
+  const bool in_c = omc <= T(1) ? (wu - v.cap.axis).squaredNorm() <= T(2) * omc * (T(1) + T(8) * e) + T(16) * e * e
+                                : (wu + v.cap.axis).squaredNorm() >= T(2) * (T(2) - omc) * (T(1) - T(8) * e) - T(16) * e * e;
+  if (!in_c) return T(0);
   const T p = base_cap_pdf(v, pivot_transform(wu, v.sptd.pivot, v.k));
   // The product overflows for densities beyond T's range (a pivot within ~eps of the sphere, a tiny cap): no
   // density rather than Inf (found by fuzz_sptd_float, issue 7).
