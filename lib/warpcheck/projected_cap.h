@@ -241,18 +241,22 @@ template <class T> ProjectedCapView<T> make_projected_cap_view(const SphereLight
   const SphereView<T>& s = p.sphere;
   const Vec3<T> wd = s.frame.z;
   p.z = s.normal;
-  // The horizontal part of w_d by two Gram-Schmidt passes with the UNclamped height: for a light (nearly) overhead
-  // the true horizontal part can be far below eps, and one pass (or subtracting the clamped height, when the
+  // The horizontal part of w_d, n x (w_d x n) (= w_d - (n.w_d) n for unit n). For a light (nearly) overhead the
+  // true horizontal part can be far below eps. One Gram-Schmidt pass (or subtracting the clamped height, when the
   // rounded w_d has n.w_d = 1 + ulp) leaves a rounding residue ~eps along n that outweighs it, turning x towards
   // n (found by the worst-case search precision-sphere-projected-cap-double-angle: long double x came out
-  // (-0.225, 0, 0.974) for an overhead light, 0.65 rad between the double and long double samples). The second
-  // pass removes the residue along n, so x is horizontal to rounding and as accurate as w_d's own horizontal
-  // components (exact for an axis-aligned normal). No threshold below which x is replaced: a threshold depends
-  // on eps_T, so float/double and long double would choose different x's between their thresholds, which is
-  // the same O(1) rotation of the samples this fixes; x is replaced only when the horizontal part is exactly 0.
+  // (-0.225, 0, 0.974) for an overhead light, 0.65 rad between the double and long double samples). A second
+  // pass is not enough when the light is overhead to rounding (w_d x n ~ eps): the first residue is then noise,
+  // and the second pass leaves ~eps of it in any direction, along n too (found by fuzz_projected_cap_double,
+  // issue 7: x parallel to n, y = 0, a sample at n.w = -1 for a cap of 90 deg overhead). An outer cross product
+  // with n is orthogonal to n up to eps of its own length whatever the inner one holds, so x is horizontal to
+  // rounding even where its direction is noise, and as accurate as w_d's horizontal components (absolute eps in
+  // each component of w_d x n; exact for an axis-aligned normal). No threshold below which x is replaced: a
+  // threshold depends on eps_T, so float/double and long double would choose different x's between their
+  // thresholds, which is the same O(1) rotation of the samples this fixes; x is replaced only when the
+  // horizontal part is exactly 0.
   const T h_raw = p.z.dot(wd);
-  Vec3<T> horizontal = wd - h_raw * p.z;
-  horizontal -= horizontal.dot(p.z) * p.z;
+  const Vec3<T> horizontal = p.z.cross(Vec3<T>(wd.cross(p.z)));
   p.h = std::clamp(h_raw, T(-1), T(1));
   p.w_dx = horizontal.stableNorm();
   p.x = p.w_dx > T(0) ? Vec3<T>(horizontal / p.w_dx) : Frame<T>::from_z(p.z).x;  // overhead: any horizontal x
@@ -262,7 +266,11 @@ template <class T> ProjectedCapView<T> make_projected_cap_view(const SphereLight
   p.r_x = p.h * p.r_y, p.r_z = p.w_dx * p.r_y, p.c_x = p.w_dx * p.v, p.c_z = p.h * p.v;
   const T h = p.h, ry = p.r_y, v = p.v;
   if (h <= -ry) return p.reason = NoSample::kBelowHorizon, p;  // Case 4 (make_sphere_view catches it first)
-  if (h >= ry) {
+  // Cases 2-3 divide by w_dx (w_dx > v >= 0 when h < r_y). With w_dx = 0 the rounded w_d is n (up to the
+  // rounding of the cross product), so h < r_y can only be the rounding of h = 1 against r_y = 1: an overhead
+  // light touching the horizon, Case 1 (found by fuzz_projected_cap_float with r_y = 1 in float, UBSan's
+  // float-divide-by-zero in t_x = v / w_dx once x came from the cross product, issue 7).
+  if (h >= ry || !(p.w_dx > T(0))) {
     // Case 1 (Alg. 3): the whole ellipse; t_x >= 1 is never needed.
     p.which_case = 1;
     p.area_e_unit = kPi<T>;
