@@ -292,7 +292,9 @@ template <class T> ProjectedCapView<T> make_projected_cap_view(const SphereLight
           cut_disk_preimage<T, CutDiskInverse::kQuintic>(v * h / (ry * p.w_dx), std::sqrt(chord2) / (ry * p.w_dx)).left_area;
       p.area_e = p.r_x * p.r_y * p.area_e_unit;
       p.total = p.area_e + p.area_d;
-      p.tau = p.area_e / p.total;
+      // Both areas can underflow to 0 (r_y = 7.5e-155, r_x = 0): tau only for a positive total, which is tested
+      // below (found by fuzz_projected_cap_double under UBSan's float-divide-by-zero, issue 7).
+      p.tau = p.total > T(0) ? p.area_e / p.total : T(0);
     } else {
       // Case 3 (Alg. 4).
       p.which_case = 3;
