@@ -317,7 +317,9 @@ namespace projected_cap_detail {
 template <class T> T case3_sy(const ProjectedCapView<T>& p, T d_z, T w_z) {
   const T num = p.r_y * p.r_y * p.top * (p.rz_minus_cz + w_z);
   const T den = p.t_y * p.r_z * p.r_z * (p.t_y + d_z);
-  return std::sqrt(std::max(T(0), num / den));
+  // den underflows to 0 for a lune below T's range (t_y or r_z ~ 1e-160): no width there rather than a
+  // division by zero (found by fuzz_projected_cap_double under UBSan's float-divide-by-zero, issue 7).
+  return den > T(0) ? std::sqrt(std::max(T(0), num / den)) : T(0);
 }
 
 // w_z = sqrt(1 - w_x^2 - w_y^2). Near the rim the sum of squares (rounding ~1.5 eps) is as accurate as
@@ -352,7 +354,10 @@ template <class T> Local<T> disk_to_local(const ProjectedCapView<T>& p, int piec
     const T w_x = lift(w_y, w_z);
     o.w = Vec3<T>(w_x, w_y, w_z);
     // Alg. 4: p = -t_y^2 / ((c_z + r_z)^2 A_D) w_x / (d_x s_y) = w_x / (k^2 s_y |d_x|) per unit disk density.
-    o.pdf_proj = w_x / (inv_disk_density * (p.k * p.k) * s_y * std::abs(dx));
+    // Where the lune has no width in T (s_y = 0) or d_x = 0 the density is not representable: 0, which the
+    // sampler turns into "no sample" (it divided by zero, fuzz_projected_cap_double under UBSan, issue 7).
+    const T den = inv_disk_density * (p.k * p.k) * s_y * std::abs(dx);
+    o.pdf_proj = den > T(0) ? w_x / den : T(0);
   }
   return o;
 }
@@ -403,8 +408,13 @@ template <class T, CutDiskInverse M> int pieces(const ProjectedCapView<T>& p, st
         const T ae = q ? p.quintic_area_e_unit : p.area_e_unit;
         out[n++] = {0, T(0), p.tau, T(0), q ? ae / p.tau : p.total / (p.r_x * p.r_y)};
       }
-      const T ad = q ? p.quintic_area_d / (T(1) - p.tau) : p.total;
-      out[n++] = {1, p.tau, T(1), ad, -ad};
+      // tau rounds to 1 when A_D < eps A_E / 2: the disk piece then has no u0 range (and 1 / (1 - tau) is a
+      // division by zero, found by fuzz_projected_cap_double under UBSan, issue 7); its share of the
+      // normaliser is below rounding. area_e > 0 there, so the ellipse piece exists.
+      if (p.tau < T(1)) {
+        const T ad = q ? p.quintic_area_d / (T(1) - p.tau) : p.total;
+        out[n++] = {1, p.tau, T(1), ad, -ad};
+      }
       return n;
     }
     case 3: {
