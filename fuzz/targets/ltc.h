@@ -193,7 +193,11 @@ template <class T> void check_ltc(FuzzedDataProvider& in, const Mutation& mutate
     L stretch_inv = 0;
     for (int i = 0; i < ref.transformed.light.count; ++i) {
       const Vec3<L> l = ref.m * ref.transformed.light.vertices[i];
-      stretch_inv = std::max(stretch_inv, l.norm() / (ref.sigma3 * ref.transformed.light.vertices[i].norm()));
+      // A vertex at the shading point (length 0): the stretch is unbounded, and the check below is skipped
+      // (the reference divided by 0 there: UBSan, fuzz_ltc_double 5288b69a, issue 7).
+      const L vn = ref.transformed.light.vertices[i].norm();
+      stretch_inv = vn > 0 ? std::max(stretch_inv, l.norm() / (ref.sigma3 * vn)) : std::numeric_limits<L>::infinity();
+      if (!(vn > 0)) break;
     }
     const L shift = stretch_inv * (e * kappa_w + ref.inverse_error) + e * (1 + kappa_t);
     const L rel = a_ref > 0 ? kTwoPi<L> * shift / a_ref + 16 * eps<T>() : L(1);
