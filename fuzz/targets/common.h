@@ -14,6 +14,12 @@
 // in its plane, on an edge's line, a normal perpendicular to the light, an edge through the zenith, ...), with
 // an optional tiny offset off the degeneracy.
 //
+// Order. Every value is decoded in its own statement (or in a declaration list, or a comma expression, which are
+// sequenced): the order in which the operands of one expression or the arguments of one call are evaluated is
+// unspecified, and g++ (right to left) and clang (left to right) differ, so an input that libFuzzer (clang) found
+// would decode to another geometry in the g++ replay. Where an earlier version combined two decodings in one
+// expression, they are now decoded left to right, as clang did.
+//
 // Tolerances (the geometry's conditioning). A kernel in precision T first forms differences V - x of world
 // coordinates; each carries an absolute rounding error of about eps_T (|V|_inf + |x|_inf), i.e. an angular
 // error of eps_T (|V|_inf + |x|_inf) / |V - x| in the direction of V seen from x. A point of a polygon whose
@@ -116,8 +122,10 @@ template <class T> T scalar(FuzzedDataProvider& in, T scale = T(1)) {
   if (mode < 24) return special_value<T>(in.ConsumeIntegral<std::uint8_t>());
   if (mode < 96) return scale * T(in.ConsumeIntegralInRange<int>(-4, 4));
   if (mode < 120) return finite_or_zero(from_bits<T>(in));
-  if (mode < 136) return scale * std::ldexp(T(in.ConsumeIntegralInRange<int>(-8, 8)),
-                                            in.ConsumeIntegralInRange<int>(-160, 160));
+  if (mode < 136) {
+    const T mantissa = T(in.ConsumeIntegralInRange<int>(-8, 8));  // before the exponent (see "Order" above)
+    return scale * std::ldexp(mantissa, in.ConsumeIntegralInRange<int>(-160, 160));
+  }
   // Moderate: 16 bits spread over [-4, 4] scale.
   return scale * (T(in.ConsumeIntegral<std::uint16_t>()) / T(8192) - T(4));
 }
@@ -167,6 +175,13 @@ template <class T> Vec3<T> perpendicular(FuzzedDataProvider& in, const Vec3<T>& 
   return std::cos(phi) * f.x + std::sin(phi) * f.y;
 }
 
+// A point near p: p + v t, with v a decoded vector (unit scale) and t a tiny offset relative to `scale`, decoded
+// in that order.
+template <class T> Vec3<T> near(FuzzedDataProvider& in, const Vec3<T>& p, T scale = T(1)) {
+  const Vec3<T> v = vec3<T>(in, T(1));
+  return p + v * tiny<T>(in, scale);
+}
+
 // ---- Polygons leaning towards degeneracy -------------------------------------------------------------------
 
 // A polygon: raw vertices (often invalid), a convex polygon from sorted angles on an ellipse (coincident
@@ -199,7 +214,11 @@ template <class T> PolygonLight<T> decode_polygon(FuzzedDataProvider& in, bool r
   const bool regular = in.ConsumeBool();
   T acc = 0;
   for (int i = 0; i < n; ++i) {
-    const T step = regular ? T(1) : T(in.ConsumeIntegralInRange<int>(0, 255)) + tiny<T>(in, T(1));
+    T step = T(1);
+    if (!regular) {
+      const T whole = T(in.ConsumeIntegralInRange<int>(0, 255));
+      step = whole + tiny<T>(in, T(1));
+    }
     t[i] = acc;
     acc += std::max(T(0), step);
   }
@@ -239,13 +258,18 @@ template <class T> ShadingPoint<T> decode_polygon_shading(FuzzedDataProvider& in
     }
     case 2: {  // on the line of edge j, possibly just off it
       const T t = scalar<T>(in);
-      sp.position = p.vertices[j] + t * (p.vertices[j1] - p.vertices[j]) + nhat * tiny<T>(in, sz) +
-                    perpendicular(in, nhat) * tiny<T>(in, sz);
+      const T off_plane = tiny<T>(in, sz);
+      const Vec3<T> side = perpendicular(in, nhat);
+      sp.position = p.vertices[j] + t * (p.vertices[j1] - p.vertices[j]) + nhat * off_plane + side * tiny<T>(in, sz);
       break;
     }
-    case 3: sp.position = p.vertices[j] + vec3<T>(in, T(1)) * tiny<T>(in, sz); break;  // at a vertex
+    case 3: sp.position = near(in, p.vertices[j], sz); break;  // at a vertex
     case 4: sp.position = polygon_centroid(p) + nhat * scalar<T>(in, sz); break;       // on the axis
-    case 5: sp.position = polygon_centroid(p) + vec3<T>(in, sz) * std::ldexp(T(1), in.ConsumeIntegralInRange<int>(0, 120)); break;
+    case 5: {
+      const Vec3<T> d = vec3<T>(in, sz);
+      sp.position = polygon_centroid(p) + d * std::ldexp(T(1), in.ConsumeIntegralInRange<int>(0, 120));
+      break;
+    }
     default: sp.position = polygon_centroid(p) + vec3<T>(in, sz); break;
   }
   const Vec3<T> to_light = polygon_centroid(p) - sp.position;
@@ -260,7 +284,7 @@ template <class T> ShadingPoint<T> decode_polygon_shading(FuzzedDataProvider& in
       break;
     }
     case 5: sp.normal = perpendicular(in, nhat); break;  // the light's plane contains the normal
-    default: sp.normal = safe_normalized(to_light) + vec3<T>(in) * tiny<T>(in, T(1)); break;
+    default: sp.normal = near(in, safe_normalized(to_light)); break;
   }
   return sp;
 }
@@ -283,8 +307,8 @@ template <class T> L eps() { return L(std::numeric_limits<T>::epsilon()); }
 inline constexpr long double kSubnormalUlps = 16;
 
 // kappa = 1 + max_k (|V_k|_inf + |x|_inf + kSubnormalUlps min_T) / |V_k - x| over the given points (see the
-// header comment).
-template <class T> L kappa_of(const Vec3<T>* v, int n, const Vec3<T>& x) {
+// header comment). P: the points' type (T, or L for points computed in long double); T: the kernel's precision.
+template <class P, class T = P> L kappa_of(const Vec3<P>* v, int n, const Vec3<P>& x) {
   L k = 1;
   const Vec3<L> xl = x.template cast<L>();
   for (int i = 0; i < n; ++i) {
@@ -372,5 +396,71 @@ template <class T> void check_pdf_consistency(T sample_pdf, T eval_pdf, L rel, L
                          geometry << "sample pdf " << sample_pdf << " pdf(direction) " << eval_pdf << " ratio - 1 "
                                   << (ratio - 1) << " allowed " << rel << "\n");
 }
+
+// pdf(direction) of a kernel whose density is only piecewise smooth (pieces of a warp meeting along seams,
+// folds where two branches reach a direction, the support's boundary), against the sample's pdf. The kernel
+// evaluates its density at a direction that rounding has moved by up to a backward error `delta` (an angle,
+// derived by the caller) from the one its sampler meant, so the two values agree only up to the density's
+// variation within delta: a cosine near the horizon varies by delta / cos, and within delta of a jump the
+// variation is the jump itself. We measure that variation: pdf at w and at four probes at angle delta from w
+// (+- two orthogonal tangents), V = max_k |pdf(probe_k) / pdf(w) - 1|. Over the disk of radius delta a linear
+// density varies by at most sqrt(2) times what the four probes show; the sample's pdf must agree with pdf(w) to
+// 2 V plus the relative rounding `rel` of the density formulas. A density off by 1 % fails wherever it varies by
+// less than 0.5 % within delta, i.e. everywhere except within delta of a jump. pdf(w) = 0: allowed within tol of
+// the light's boundary (margin <= tol, as in check_pdf_consistency) or when a probe is not 0 (within delta of
+// the support's edge). With delta >= 1/2 rad the comparison carries no information.
+template <class T, class Pdf>
+void check_pdf_consistency_probed(T sample_pdf, const Vec3<T>& w, Pdf&& pdf, L delta, L rel, L margin, L tol,
+                                  const std::string& geometry) {
+  const T p0 = pdf(w);
+  WARPCHECK_FUZZ_REQUIRE(std::isfinite(p0) && p0 >= T(0), "pdf(direction) not finite and >= 0",
+                         geometry << "pdf(direction) " << p0 << "\n");
+  if (!(delta < L(0.5))) return;
+  const Vec3<L> wl = w.template cast<L>().normalized();
+  const Frame<L> f = Frame<L>::from_z(wl);
+  T probes[4];
+  L hi = 0, variation = 0;
+  for (int k = 0; k < 4; ++k) {
+    const Vec3<L> t = (k % 2 == 0 ? f.x : f.y) * (k < 2 ? delta : -delta);
+    const Vec3<T> wk = Vec3<L>((wl + t).normalized()).template cast<T>();
+    probes[k] = pdf(wk);
+    WARPCHECK_FUZZ_REQUIRE(std::isfinite(probes[k]) && probes[k] >= T(0), "pdf(direction) not finite and >= 0",
+                           geometry << "pdf at probe " << show(wk) << ": " << probes[k] << "\n");
+    hi = std::max(hi, L(probes[k]));
+    if (p0 > T(0)) variation = std::max(variation, std::abs(L(probes[k]) / L(p0) - 1));
+  }
+  if (p0 == T(0)) {
+    WARPCHECK_FUZZ_REQUIRE(margin <= tol || hi > 0, "pdf(direction) is 0 around a direction well inside the light",
+                           geometry << "sample pdf " << sample_pdf << " margin " << margin << " tol " << tol
+                                    << " probe radius " << delta << "\n");
+    return;
+  }
+  const L allowed = 2 * variation + rel;
+  if (allowed >= L(0.5)) return;
+  const L ratio = L(sample_pdf) / L(p0);
+  WARPCHECK_FUZZ_REQUIRE(std::abs(ratio - 1) <= allowed, "pdf(direction) disagrees with the sample's pdf",
+                         geometry << "sample pdf " << sample_pdf << " pdf(direction) " << p0 << " ratio - 1 " << (ratio - 1)
+                                  << " allowed " << allowed << " (probes " << probes[0] << " " << probes[1] << " "
+                                  << probes[2] << " " << probes[3] << " at radius " << delta << ")\n");
+}
+
+// ---- Negative controls ---------------------------------------------------------------------------------------
+
+// A deliberately broken kernel, for the negative controls (fuzz/tests/test_fuzz_checks.cpp): the families that
+// take a Mutation apply it to every sample the kernel returns and to every pdf(direction) value before the
+// checks see them, and to the normalising constants their view-level checks compare with a reference. The
+// libFuzzer targets and the replay use the default, kNone.
+struct Mutation {
+  enum Kind { kNone, kSamplePdfTimes1_01, kSampleDirectionNegated, kPdfTimes1_01, kNormaliserTimes1_01 } kind = kNone;
+  template <class T> DirectionSample<T> sample(DirectionSample<T> s) const {
+    if (!s.valid()) return s;
+    if (kind == kSamplePdfTimes1_01) s.pdf *= T(1.01);
+    if (kind == kSampleDirectionNegated) s.direction = -s.direction;
+    return s;
+  }
+  template <class T> T pdf(T p) const { return kind == kPdfTimes1_01 ? p * T(1.01) : p; }
+  // A light's normalising constant as a family's view-level check sees it (e.g. the projected solid angle).
+  template <class T> T normaliser(T x) const { return kind == kNormaliserTimes1_01 ? x * T(1.01) : x; }
+};
 
 }  // namespace warpcheck::fuzz

@@ -39,9 +39,10 @@ template <class T> bool polygon_input_finite(const PolygonLightGeometry<T>& g) {
 // (max(|V_j|_inf, |V_{j+1}|_inf) + |x|_inf + 16 min_T) / dist(x, segment V_j V_{j+1}) (found by
 // fuzz_polygon_projected_double: an edge passing 4e-14 from x, whose great circle through x the coordinates
 // do not determine, issue 7). The horizon arcs of a clipped polygon lie on the exactly known horizon.
-template <class T> L polygon_kappa(const PolygonLightGeometry<T>& g, bool clipped) {
+// P: the geometry's type (T, or L for a light computed in long double, ltc.h); T: the kernel's precision.
+template <class P, class T = P> L polygon_kappa(const PolygonLightGeometry<P>& g, bool clipped) {
   const int n = g.light.count;
-  L k = kappa_of<T>(g.light.vertices.data(), n, g.shading.position);
+  L k = kappa_of<P, T>(g.light.vertices.data(), n, g.shading.position);
   const Vec3<L> x = g.shading.position.template cast<L>(), nl = g.shading.normal.template cast<L>();
   for (int j = 0; j < n; ++j) {
     const Vec3<L> vj = g.light.vertices[j].template cast<L>(), vj1 = g.light.vertices[(j + 1) % n].template cast<L>();

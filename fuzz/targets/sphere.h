@@ -1,76 +1,18 @@
 // fuzz/targets/sphere.h: sphere lights, solid-angle (Shirley 1996 Sec. 3.2.2) and visible-cap area sampling
-// (lib/warpcheck/sphere.h). Degeneracies: shading point on or just off the surface, very far away (d / r up
-// to 2^120), radius zero / negative / subnormal, normal perpendicular to the direction to the centre or
-// putting the cone exactly tangent to the horizon, NaN / Inf anywhere.
+// (lib/warpcheck/sphere.h). The geometry comes from decode_sphere (common_sphere.h, shared with projected_cap.h
+// and sptd.h).
 #pragma once
 
-#include "common.h"
-#include "warpcheck/sphere.h"
+#include "common_sphere.h"
 
 namespace warpcheck::fuzz {
-
-template <class T> SphereLightGeometry<T> decode_sphere(FuzzedDataProvider& in) {
-  SphereLightGeometry<T> g;
-  const T scale = scalar<T>(in);
-  const T s = std::isfinite(scale) && scale != T(0) ? std::abs(scale) : T(1);
-  g.light.center = vec3<T>(in, s);
-  g.light.radius = in.ConsumeBool() ? std::abs(scalar<T>(in, s)) : scalar<T>(in, s);
-  const T r = g.light.radius;
-  const Vec3<T> dir = safe_normalized(vec3<T>(in));
-  const Vec3<T> unit_dir = dir.isZero() ? Vec3<T>(T(0), T(0), T(1)) : dir;
-  switch (in.ConsumeIntegralInRange<int>(0, 4)) {
-    case 0: g.shading.position = vec3<T>(in, s); break;
-    case 1: g.shading.position = g.light.center + unit_dir * (r * (T(1) + tiny<T>(in, T(1)))); break;  // on the surface
-    case 2: g.shading.position = g.light.center + unit_dir * (r * std::ldexp(T(1), in.ConsumeIntegralInRange<int>(0, 120))); break;
-    default: g.shading.position = g.light.center + vec3<T>(in, std::isfinite(r) && r != T(0) ? std::abs(r) : T(1)); break;
-  }
-  const Vec3<T> to_c = g.light.center - g.shading.position;
-  switch (in.ConsumeIntegralInRange<int>(0, 4)) {
-    case 0: g.shading.normal = vec3<T>(in); break;
-    case 1: g.shading.normal = perpendicular(in, to_c); break;
-    case 2: {  // the cone exactly tangent to the horizon (from above or below): n.axis = -+ sin(theta_max)
-      const T d = to_c.norm();
-      const T sn = d > T(0) ? r / d : T(0);
-      const T sign = in.ConsumeBool() ? T(1) : T(-1);
-      g.shading.normal = safe_normalized(to_c) * (sign * sn) + perpendicular(in, to_c) * std::sqrt(std::max(T(0), T(1) - sn * sn));
-      break;
-    }
-    default: g.shading.normal = to_c * scalar<T>(in) + vec3<T>(in) * tiny<T>(in, T(1)); break;
-  }
-  return g;
-}
-
-template <class T> std::string describe(const SphereLightGeometry<T>& g, const Vec2<T>& u, const char* kernel) {
-  std::ostringstream os;
-  os.precision(std::numeric_limits<T>::max_digits10);
-  os << kernel << " <" << (sizeof(T) == 4 ? "float" : "double") << ">: center " << show(g.light.center) << " radius "
-     << g.light.radius << " x " << show(g.shading.position) << " n " << show(g.shading.normal) << " u (" << u[0]
-     << ", " << u[1] << ")\n";
-  return os.str();
-}
-
-// Reference: the ray's miss distance from the centre over d (the angular margin, > 0 inside) in long double.
-template <class T> L sphere_margin(const SphereLightGeometry<T>& g, const Vec3<T>& w, L* d_out, L* miss_out) {
-  const Vec3<L> to_c = g.light.center.template cast<L>() - g.shading.position.template cast<L>();
-  const Vec3<L> wl = w.template cast<L>().normalized();
-  const L d = to_c.norm(), r = L(g.light.radius);
-  const L miss = to_c.cross(wl).norm();
-  *d_out = d, *miss_out = miss;
-  if (to_c.dot(wl) <= 0) return -1;  // pointing away: outside by a right angle or more
-  return (r - miss) / d;
-}
 
 template <class T> void check_sphere(FuzzedDataProvider& in) {
   const SphereLightGeometry<T> g = decode_sphere<T>(in);
   const bool finite_input = all_finite(g.light.center) && all_finite(g.shading.position) &&
                             all_finite(g.shading.normal) && std::isfinite(g.light.radius);
-  const Vec3<T> c = g.light.center;
-  const L kappa = kappa_of<T>(&c, 1, g.shading.position);
-  // The kernels know d only to delta_d = eps_T kappa d. That moves the cone's boundary theta_max = asin(r/d) by
-  // (r/d)(delta_d/d) / cos(theta_max) <= eps_T kappa / cos(theta_max): unbounded for a point on the surface.
-  const L d_ref = (c.template cast<L>() - g.shading.position.template cast<L>()).norm(), r_ref = L(g.light.radius);
-  const L cos_max = d_ref > r_ref && r_ref > 0 ? std::sqrt((d_ref - r_ref) * (d_ref + r_ref)) / d_ref : L(0);
-  const L tol = L(kTolUlps) * eps<T>() * kappa * (1 + (cos_max > 0 ? 1 / cos_max : L(0)));
+  const SphereReference ref = sphere_reference(g);
+  const L kappa = ref.kappa, r_ref = ref.r, tol = ref.tol;
   const SphereView<T> view = make_sphere_view(g);
   const int samples = in.ConsumeIntegralInRange<int>(1, 3);
   for (int k = 0; k < samples; ++k) {
@@ -107,7 +49,7 @@ template <class T> void check_sphere(FuzzedDataProvider& in) {
   }
   // The densities at an arbitrary direction: finite, >= 0, zero outside the light and for invalid geometry.
   // Directions are unit vectors (the pdf's contract), so the decoded vector is normalised in T first.
-  const Vec3<T> w = safe_normalized(in.ConsumeBool() ? vec3<T>(in) : Vec3<T>(view.frame.z + vec3<T>(in) * tiny<T>(in, T(1))));
+  const Vec3<T> w = safe_normalized(in.ConsumeBool() ? vec3<T>(in) : near(in, view.frame.z));
   const T p0 = pdf_sphere_solid_angle(g, w), p1 = pdf_sphere_visible_area(g, w);
   const std::string geo = describe(g, Vec2<T>(Vec2<T>::Zero()), "sphere pdf") + "w " + show(w) + "\n";
   WARPCHECK_FUZZ_REQUIRE(std::isfinite(p0) && p0 >= T(0) && std::isfinite(p1) && p1 >= T(0),

@@ -70,10 +70,13 @@ template <class T> LtcPolygonView<T> make_ltc_polygon_view(const LtcPolygonGeome
   if (!g.m.allFinite()) return v.reason = NoSample::kNonFinite, v;
   v.frame = pv.frame;
   v.m = g.m;
-  // |M| > 0 (Sec. 4.1). A singular or reflecting M has no LTC; an M whose inverse overflows neither.
-  v.det = g.m.determinant();
-  if (!(v.det > T(0)) || !std::isfinite(v.det)) return v.reason = NoSample::kInvalidGeometry, v;
-  v.m_inv = g.m.inverse();
+  // |M| > 0 (Sec. 4.1). A singular or reflecting M has no LTC; an M whose inverse overflows neither. One
+  // determinant for the test and the inverse: inverse() divides by its own cofactor expansion, which can be 0
+  // where determinant() is a tiny positive number (found by fuzz_ltc_double under UBSan's float-divide-by-zero,
+  // issue 7); computeInverseAndDetWithCheck divides only by a determinant it has tested.
+  bool invertible = false;
+  g.m.computeInverseAndDetWithCheck(v.m_inv, v.det, invertible, T(0));
+  if (!invertible || !(v.det > T(0)) || !std::isfinite(v.det)) return v.reason = NoSample::kInvalidGeometry, v;
   v.det_inv = T(1) / v.det;
   if (!v.m_inv.allFinite() || !std::isfinite(v.det_inv)) return v.reason = NoSample::kInvalidGeometry, v;
   v.transformed = make_polygon_projected_view(ltc_transformed_polygon(pv, v.m_inv));

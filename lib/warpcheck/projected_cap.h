@@ -254,18 +254,22 @@ template <class T> ProjectedCapView<T> make_projected_cap_view(const SphereLight
   const SphereView<T>& s = p.sphere;
   const Vec3<T> wd = s.frame.z;
   p.z = s.normal;
-  // The horizontal part of w_d by two Gram-Schmidt passes with the UNclamped height: for a light (nearly) overhead
-  // the true horizontal part can be far below eps, and one pass (or subtracting the clamped height, when the
+  // The horizontal part of w_d, n x (w_d x n) (= w_d - (n.w_d) n for unit n). For a light (nearly) overhead the
+  // true horizontal part can be far below eps. One Gram-Schmidt pass (or subtracting the clamped height, when the
   // rounded w_d has n.w_d = 1 + ulp) leaves a rounding residue ~eps along n that outweighs it, turning x towards
   // n (found by the worst-case search precision-sphere-projected-cap-double-angle: long double x came out
-  // (-0.225, 0, 0.974) for an overhead light, 0.65 rad between the double and long double samples). The second
-  // pass removes the residue along n, so x is horizontal to rounding and as accurate as w_d's own horizontal
-  // components (exact for an axis-aligned normal). No threshold below which x is replaced: a threshold depends
-  // on eps_T, so float/double and long double would choose different x's between their thresholds, which is
-  // the same O(1) rotation of the samples this fixes; x is replaced only when the horizontal part is exactly 0.
+  // (-0.225, 0, 0.974) for an overhead light, 0.65 rad between the double and long double samples). A second
+  // pass is not enough when the light is overhead to rounding (w_d x n ~ eps): the first residue is then noise,
+  // and the second pass leaves ~eps of it in any direction, along n too (found by fuzz_projected_cap_double,
+  // issue 7: x parallel to n, y = 0, a sample at n.w = -1 for a cap of 90 deg overhead). An outer cross product
+  // with n is orthogonal to n up to eps of its own length whatever the inner one holds, so x is horizontal to
+  // rounding even where its direction is noise, and as accurate as w_d's horizontal components (absolute eps in
+  // each component of w_d x n; exact for an axis-aligned normal). No threshold below which x is replaced: a
+  // threshold depends on eps_T, so float/double and long double would choose different x's between their
+  // thresholds, which is the same O(1) rotation of the samples this fixes; x is replaced only when the
+  // horizontal part is exactly 0.
   const T h_raw = p.z.dot(wd);
-  Vec3<T> horizontal = wd - h_raw * p.z;
-  horizontal -= horizontal.dot(p.z) * p.z;
+  const Vec3<T> horizontal = p.z.cross(Vec3<T>(wd.cross(p.z)));
   p.h = std::clamp(h_raw, T(-1), T(1));
   p.w_dx = horizontal.stableNorm();
   p.x = p.w_dx > T(0) ? Vec3<T>(horizontal / p.w_dx) : Frame<T>::from_z(p.z).x;  // overhead: any horizontal x
@@ -281,7 +285,11 @@ template <class T> ProjectedCapView<T> make_projected_cap_view(const SphereLight
   const T chord2 = ry < v ? (ry - std::abs(h)) * (ry + std::abs(h)) : (p.w_dx - v) * (p.w_dx + v);
   if (h >= T(0)) p.cz_minus_rz = -chord2 / (h * v + p.w_dx * ry);
   p.one_minus_cx = (h * h + p.w_dx * p.w_dx * ry * ry) / (T(1) + p.w_dx * v);
-  if (h >= ry) {
+  // Cases 2-3 divide by w_dx (w_dx > v >= 0 when h < r_y). With w_dx = 0 the rounded w_d is n (up to the
+  // rounding of the cross product), so h < r_y can only be the rounding of h = 1 against r_y = 1: an overhead
+  // light touching the horizon, Case 1 (found by fuzz_projected_cap_float with r_y = 1 in float, UBSan's
+  // float-divide-by-zero in t_x = v / w_dx once x came from the cross product, issue 7).
+  if (h >= ry || !(p.w_dx > T(0))) {
     // Case 1 (Alg. 3): the whole ellipse; t_x >= 1 is never needed.
     p.which_case = 1;
     p.area_e_unit = kPi<T>;
@@ -306,7 +314,9 @@ template <class T> ProjectedCapView<T> make_projected_cap_view(const SphereLight
       p.quintic_right_e_unit = qe.right_area;
       p.area_e = p.r_x * p.r_y * p.area_e_unit;
       p.total = p.area_e + p.area_d;
-      p.tau = p.area_e / p.total;
+      // Both areas can underflow to 0 (r_y = 7.5e-155, r_x = 0): tau only for a positive total, which is tested
+      // below (found by fuzz_projected_cap_double under UBSan's float-divide-by-zero, issue 7).
+      p.tau = p.total > T(0) ? p.area_e / p.total : T(0);
     } else {
       // Case 3 (Alg. 4).
       p.which_case = 3;
@@ -329,7 +339,9 @@ namespace projected_cap_detail {
 template <class T> T case3_sy(const ProjectedCapView<T>& p, T d_z, T w_z) {
   const T num = p.r_y * p.r_y * p.top * (p.rz_minus_cz + w_z);
   const T den = p.t_y * p.r_z * p.r_z * (p.t_y + d_z);
-  return std::sqrt(std::max(T(0), num / den));
+  // den underflows to 0 for a lune below T's range (t_y or r_z ~ 1e-160): no width there rather than a
+  // division by zero (found by fuzz_projected_cap_double under UBSan's float-divide-by-zero, issue 7).
+  return den > T(0) ? std::sqrt(std::max(T(0), num / den)) : T(0);
 }
 
 // w_z = sqrt(1 - w_x^2 - w_y^2) for a point of the unit disk (used only for the Case-3 w_x, where no better
@@ -377,7 +389,10 @@ Local<T> disk_to_local(const ProjectedCapView<T>& p, int piece, T dx, T hh, T u1
     const T w_x = lift(w_y, w_z);
     o.w = Vec3<T>(w_x, w_y, w_z);
     // Alg. 4: p = -t_y^2 / ((c_z + r_z)^2 A_D) w_x / (d_x s_y) = w_x / (k^2 s_y |d_x|) per unit disk density.
-    o.pdf_proj = w_x / (inv_disk_density * (p.k * p.k) * s_y * std::abs(dx));
+    // Where the lune has no width in T (s_y = 0) or d_x = 0 the density is not representable: 0, which the
+    // sampler turns into "no sample" (it divided by zero, fuzz_projected_cap_double under UBSan, issue 7).
+    const T den = inv_disk_density * (p.k * p.k) * s_y * std::abs(dx);
+    o.pdf_proj = den > T(0) ? w_x / den : T(0);
   }
   return o;
 }
@@ -451,8 +466,13 @@ template <class T, CutDiskInverse M> int pieces(const ProjectedCapView<T>& p, st
         out[n++] = {0, T(0), p.tau, T(0), q ? ae / p.tau : p.total / (p.r_x * p.r_y),
                     q ? p.quintic_right_e_unit : p.right_e_unit};
       }
-      const T ad = q ? p.quintic_area_d / (T(1) - p.tau) : p.total;
-      out[n++] = {1, p.tau, T(1), ad, -ad};
+      // tau rounds to 1 when A_D < eps A_E / 2: the disk piece then has no u0 range (and 1 / (1 - tau) is a
+      // division by zero, found by fuzz_projected_cap_double under UBSan, issue 7); its share of the
+      // normaliser is below rounding. area_e > 0 there, so the ellipse piece exists.
+      if (p.tau < T(1)) {
+        const T ad = q ? p.quintic_area_d / (T(1) - p.tau) : p.total;
+        out[n++] = {1, p.tau, T(1), ad, -ad};
+      }
       return n;
     }
     case 3: {

@@ -48,6 +48,7 @@
 #include <boost/math/tools/roots.hpp>
 
 #include "warpcheck/core.h"
+#include "warpcheck/projected_cap.h"  // cut_disk_area_from_angle
 #include "warpcheck/sphere.h"
 
 namespace warpcheck {
@@ -97,15 +98,26 @@ template <class T> Cap<T> pivot_transform_cap(const Cap<T>& c, const Vec3<T>& rp
   if (c.one_minus_cos >= T(2)) return Cap<T>{c.axis, T(2)};  // the whole sphere maps onto itself
   const Vec3<T>& wc = c.axis;
   // The plane through the origin, w_c and r_p (Fig. 3 (1)); any plane through w_c when r_p is parallel to it.
+  // Two Gram-Schmidt passes: with r_p nearly parallel to w_c one pass leaves a component along w_c of ~eps |r_p|,
+  // so t.w_c / |t| is rounding noise and the boundary points below lie off the sphere, where the anti-inversion
+  // form of g does not apply (found by fuzz_sptd_double: |t| = 2.1e-14, t.w_c / |t| = -6.1e-3, boundary points
+  // 1.1e-6 off the unit sphere, the image's 1 - cos off by 3.8e-5, issue 7). After the second pass t is orthogonal
+  // to w_c up to rounding; below the threshold it is noise, and every plane through w_c is one of symmetry.
+  // For a tiny pivot the squares of t's entries underflow (found by fuzz_sptd_double with |r_p| = 8e-153: t / |t|
+  // off unit length, the image's 1 - cos off by 2.4e-4, issue 7): stableNorm, and below min_T / eps_T (subnormal
+  // products lose their precision; |r_p| = 2e-308: 1 - cos off by 6e-9) any plane, as the pivot is negligible.
   Vec3<T> t = rp - rp.dot(wc) * wc;
-  const T tn = t.norm();
-  t = tn > T(64) * std::numeric_limits<T>::epsilon() * rp.norm() && tn > T(0) ? Vec3<T>(t / tn)
-                                                                               : Frame<T>::from_z(wc).x;
+  t -= t.dot(wc) * wc;
+  const T tn = t.stableNorm();
+  constexpr T e = std::numeric_limits<T>::epsilon();
+  t = tn > T(64) * e * rp.stableNorm() && tn > std::numeric_limits<T>::min() / e ? Vec3<T>(t / tn)
+                                                                                : Frame<T>::from_z(wc).x;
   const T omc = c.one_minus_cos;
   const T cos_a = T(1) - omc, sin_a = std::sqrt(std::max(T(0), omc * (T(2) - omc)));
   // Fig. 3 (2)-(3): the boundary points in that plane and their images.
-  const Vec3<T> g1 = pivot_transform(Vec3<T>(cos_a * wc + sin_a * t), rp, k);
-  const Vec3<T> g2 = pivot_transform(Vec3<T>(cos_a * wc - sin_a * t), rp, k);
+  const Vec3<T> p1 = cos_a * wc + sin_a * t, p2 = cos_a * wc - sin_a * t;
+  const Vec3<T> g1 = pivot_transform(p1, rp, k);
+  const Vec3<T> g2 = pivot_transform(p2, rp, k);
   const Vec3<T> gc = pivot_transform(wc, rp, k);
   // Eq. 6 (in-plane bisector), robust for image caps of any size.
   const Vec3<T> sum = g1 + g2, diff = g1 - g2;
@@ -115,9 +127,37 @@ template <class T> Cap<T> pivot_transform_cap(const Cap<T>& c, const Vec3<T>& rp
     const Vec3<T> m = wc.cross(t).cross(diff);  // in the plane, orthogonal to g1 - g2
     axis = m / m.norm();
   }
-  if ((gc - axis).squaredNorm() > (g1 - axis).squaredNorm()) axis = -axis;  // g(w_c) lies inside g(C)
-  // Eq. 7, as a chord length (1 - cos = |g_i - axis|^2 / 2) averaged over both boundary points.
-  const T image_omc = std::min(T(2), ((g1 - axis).squaredNorm() + (g2 - axis).squaredNorm()) / T(4));
+  // g(w_c) lies inside g(C). That test compares distances of the order of the image's size, which are noise for an
+  // image below the resolution of T's directions (found by fuzz_sptd_double: an image of 5e-18 rad oriented as the
+  // whole sphere, density 4e-21 instead of 1.8e14, issue 7). But g stretches lengths on C by at most k / d_min^2
+  // (Eq. 4; d_min the distance from r_p to C: 1 - |r_p| if C contains r_p's direction, else that to the nearer
+  // boundary point, p1 or p2), so g(C) has diameter <= 2 alpha k / d_min^2; below pi/2 it cannot be the complement
+  // of the cap around the bisector (diameter >= pi): no flip there.
+  const T rn = rp.norm();
+  const bool contains_pivot = rn > T(0) && (rp / rn - wc).squaredNorm() <= T(2) * omc;
+  const T d_min = contains_pivot ? T(1) - rn : std::min((p1 - rp).norm(), (p2 - rp).norm());
+  const T alpha = T(2) * std::asin(std::min(T(1), std::sqrt(omc / T(2))));
+  const bool surely_small = T(2) * alpha * k < kPi<T> / T(2) * d_min * d_min;
+  if (!surely_small && (gc - axis).squaredNorm() > (g1 - axis).squaredNorm()) axis = -axis;
+  // Eq. 7, as a chord length (1 - cos = |g_i - axis|^2 / 2) averaged over both boundary points. Where the image
+  // circle is small (the image cap or its complement within 30 degrees) that chord is a difference of nearly equal
+  // unit vectors and loses eps / psi' relatively (found by fuzz_sptd_double: psi' = 2.5e-12, 1 - cos off by
+  // 3.3e-5, issue 7). There we use the distance formula of the inversion instead (derived here, not in the paper):
+  // g is the inversion about r_p of power k followed by the point reflection through r_p, so |g(p) - g(q)| =
+  // k |p - q| / (|p - r_p| |q - r_p|), and g1, g2 are the ends of a diameter of the image circle (which is
+  // symmetric about the plane); hence sin(psi'') = k sin(alpha) / (|p1 - r_p| |p2 - r_p|) for the smaller of the
+  // two caps the circle bounds, and 1 - cos(psi'') = s^2 / (1 + sqrt(1 - s^2)) without cancellation.
+  // (A boundary point can coincide with r_p in T when |r_p| is within an ulp of 1: then the formula is not used;
+  // found by fuzz_sptd_double under UBSan's float-divide-by-zero, issue 7.)
+  const T chord_denominator = (p1 - rp).norm() * (p2 - rp).norm();
+  const T s = chord_denominator > T(0) ? k * sin_a / chord_denominator : T(1);
+  T image_omc;
+  if (s < T(0.5)) {
+    const T small = s * s / (T(1) + std::sqrt((T(1) - s) * (T(1) + s)));
+    image_omc = axis.dot(g1) >= T(0) ? small : T(2) - small;
+  } else {
+    image_omc = std::min(T(2), ((g1 - axis).squaredNorm() + (g2 - axis).squaredNorm()) / T(4));
+  }
   return Cap<T>{axis, image_omc};
 }
 template <class T> Cap<T> pivot_transform_cap(const Cap<T>& c, const Vec3<T>& rp) {
@@ -153,6 +193,7 @@ template <class T> struct CosineCapView {
   T cos_a = 0, sin_a = 0;      // cap half-angle alpha
   T cos_t = 0, sin_t = 0;      // angle t between the cap axis and n
   T xc = 0, A = 0, x0 = 0;     // ellipse centre and x semi-axis; x >= x0: full chord side
+  T seg0 = 0;                  // area of the unit disk right of x0, without cancellation (make_cosine_cap_view)
   bool ellipse_only = false;   // R = E (cap entirely above the horizon)
   T area = 0;                  // projected solid angle of (cap, upper hemisphere) = area of R
 
@@ -164,14 +205,20 @@ template <class T> struct CosineCapView {
     const T t = std::clamp((x - xc) / A, T(-1), T(1));
     return sin_a * A * (t * std::sqrt((T(1) - t) * (T(1) + t)) + std::asin(t) + kPi<T> / T(2));
   }
-  static T disk_cdf(T x) {
-    x = std::clamp(x, T(-1), T(1));
-    return x * std::sqrt((T(1) - x) * (T(1) + x)) + std::asin(x) + kPi<T> / T(2);
+  // Area of the unit disk right of x = cos(theta), theta in [0, pi]: C(theta) = theta - sin(theta) cos(theta) by
+  // projected_cap.h's cut_disk_area_from_angle (a series where that difference cancels) up to pi/2, pi - C(pi -
+  // theta) beyond. The area of the disk between x0 and x was the difference of two areas left of them, ~pi each,
+  // which leaves an absolute error of ~eps pi: relatively ~eps pi / area for a small cap straddling the horizon
+  // (found by fuzz_sptd_double: image cap of 1.4e-3 rad on the horizon, area 1.76e-9 off by 4e-7, issue 7).
+  static T disk_right_of_angle(T theta) {
+    return theta <= kPi<T> / T(2) ? cut_disk_area_from_angle(theta) : kPi<T> - cut_disk_area_from_angle(kPi<T> - theta);
   }
-  // Area of R with abscissa < x.
+  static T disk_right_of(T x) { return disk_right_of_angle(std::acos(std::clamp(x, T(-1), T(1)))); }
+  // Area of R with abscissa < x; the disk part between x0 and x as seg0 - (disk right of x).
   T cdf(T x) const {
-    if (cos_t >= T(0)) return ellipse_cdf(std::min(x, x0)) + (x > x0 ? disk_cdf(x) - disk_cdf(x0) : T(0));
-    return x > x0 ? std::max(T(0), (disk_cdf(x) - disk_cdf(x0)) - (ellipse_cdf(x) - ellipse_cdf(x0))) : T(0);
+    const T disk = x > x0 ? std::max(T(0), seg0 - disk_right_of(x)) : T(0);
+    if (cos_t >= T(0)) return ellipse_cdf(std::min(x, x0)) + disk;
+    return x > x0 ? std::max(T(0), disk - (ellipse_cdf(x) - ellipse_cdf(x0))) : T(0);
   }
   // Half-height of E at abscissa x (0 outside it).
   T ellipse_half_height(T x) const {
@@ -202,7 +249,14 @@ template <class T> CosineCapView<T> make_cosine_cap_view(const Cap<T>& cap, cons
   // x >= x0 <=> cos(alpha) - x sin(t) <= 0; clamped to +-2 (only comparisons with x in [-1, 1] matter).
   if (v.sin_t > T(0)) v.x0 = std::clamp(v.cos_a / v.sin_t, T(-2), T(2));
   else v.x0 = v.cos_a > T(0) ? T(2) : T(-2);
-  v.ellipse_only = v.cos_t >= T(0) && v.x0 >= v.xc + v.A;
+  // The disk's area right of x0 as a segment area (cdf): x0 itself is known to an absolute eps either way.
+  v.seg0 = v.x0 >= T(1) ? T(0) : v.x0 <= T(-1) ? kPi<T> : CosineCapView<T>::disk_right_of(v.x0);
+  // R = E exactly when the cap lies entirely above the horizon, alpha + t <= pi/2, i.e. cos(alpha) >= sin(t) (both
+  // angles in [0, pi/2] there). The test x0 >= x_c + A (= sin(t + alpha)) is equivalent only for cos(t) > 0: at
+  // cos(t) = 0 it reads x0 >= x_c, which holds up to rounding for any alpha (found by fuzz_sptd_double: a cap of
+  // half-angle 24 deg with its axis on the horizon, cos(t) = 5e-39, got the area of its degenerate ellipse, 2.5e-39,
+  // and a density of 3e40 instead of 1455, issue 7).
+  v.ellipse_only = v.cos_t >= T(0) && v.cos_a >= v.sin_t;
   v.area = v.ellipse_only ? kPi<T> * v.sin_a * v.A : v.cdf(T(1));
   if (!(v.area > T(0)) || !std::isfinite(v.area)) return v.reason = NoSample::kBelowHorizon, v;
   return v;
@@ -367,6 +421,9 @@ template <class T> SptdCapView<T> make_sptd_cap_view(const SptdCapGeometry<T>& g
     if (!v.cosine.valid()) return v.reason = v.cosine.reason, v;
     v.base_integral = v.cosine.area / kPi<T>;
   }
+  // The normalised base density 1 / |g(C)| resp. 1 / area must be representable (as for sphere lights, sphere.h).
+  const T norm = v.sptd.base == SptdBase::kUniform ? v.image.solid_angle() : v.cosine.area;
+  if (!std::isfinite(T(1) / norm)) return v.reason = NoSample::kTooSmall, v;
   return v;
 }
 
@@ -386,8 +443,21 @@ template <class T> T pdf_sptd_cap(const SptdCapView<T>& v, const Vec3<T>& w) {
   const T len = w.norm();
   if (!(len > T(0))) return T(0);
   const Vec3<T> wu = w / len;
+  // 0 outside C, tested on C itself, not only through the image: in T the image cap can swallow C's complement,
+  // where its 1 - cos is within rounding of 2 (found by fuzz_sptd_double: |r_p| = 1 - 9e-13, a C of 120 deg whose
+  // image is the sphere minus a cap of ~1e-12 rad, stored as 1 - cos = 2: pdf > 0 at 0.45 rad outside C, issue 7).
+  // By the chord to the axis for C up to a hemisphere, to the antipode for larger C (whose complement's chord,
+  // 2 - (1 - cos), is then exact), each with a relative slack of 8 eps plus a chord of 4 eps for the rounding of
+  // unit directions; a relative slack on the chord to the axis would be ~1e-3 rad near the antipode in float.
+  const T e = std::numeric_limits<T>::epsilon(), omc = v.cap.one_minus_cos;
+  const bool in_c = omc <= T(1) ? (wu - v.cap.axis).squaredNorm() <= T(2) * omc * (T(1) + T(8) * e) + T(16) * e * e
+                                : (wu + v.cap.axis).squaredNorm() >= T(2) * (T(2) - omc) * (T(1) - T(8) * e) - T(16) * e * e;
+  if (!in_c) return T(0);
   const T p = base_cap_pdf(v, pivot_transform(wu, v.sptd.pivot, v.k));
-  return p > T(0) ? p * pivot_jacobian(wu, v.sptd.pivot, v.k) : T(0);
+  // The product overflows for densities beyond T's range (a pivot within ~eps of the sphere, a tiny cap): no
+  // density rather than Inf (found by fuzz_sptd_float, issue 7).
+  const T pdf = p > T(0) ? p * pivot_jacobian(wu, v.sptd.pivot, v.k) : T(0);
+  return std::isfinite(pdf) ? pdf : T(0);
 }
 
 template <class T> DirectionSample<T> sample_sptd_cap(const SptdCapView<T>& v, const Vec2<T>& u) {

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <boost/math/statistics/t_test.hpp>
+#include <cfenv>
 #include <cstdio>
 #include <random>
 
@@ -55,6 +56,21 @@ TEST(Ltc, SingularOrReflectingTransformsGiveNoSample) {
   m(2, 2) = std::nan("");
   EXPECT_EQ(sample_ltc_polygon(LtcPolygonGeometry<double>{pg, m}, Vec2<double>(0.5, 0.5)).reason, NoSample::kNonFinite);
   EXPECT_EQ(pdf_ltc_polygon(LtcPolygonGeometry<double>{pg, m}, Vec3<double>(0.5, 0, 1)), 0);
+  // Singular up to rounding: determinant() is 1.4e-17 > 0, but the cofactor expansion that Eigen's inverse()
+  // divides by is exactly 0 (its inverse() has -inf entries). No sample, and no division by zero: UBSan's
+  // float-divide-by-zero in the sanitizer build, the FE_DIVBYZERO flag in any build (raised here before
+  // make_ltc_polygon_view inverted with the determinant it tests; measured with g++ -O3, where the view of the
+  // identity raises none).
+  Mat3<double> s;
+  s << -0.97724830453404243, -0.71395549903980848, 0.31213760910876431, -0.011186738735074364, 0.45739249687330075,
+      0.25797111957173724, 0.56127352143764009, -0.45829810002916671, -0.65376533080210242;
+  ASSERT_GT(s.determinant(), 0);
+  ASSERT_FALSE(Mat3<double>(s.inverse()).allFinite());
+  std::feclearexcept(FE_DIVBYZERO);
+  const auto singular = make_ltc_polygon_view(LtcPolygonGeometry<double>{pg, s});
+  EXPECT_FALSE(std::fetestexcept(FE_DIVBYZERO)) << "make_ltc_polygon_view divided by zero";
+  EXPECT_EQ(singular.reason, NoSample::kInvalidGeometry);
+  EXPECT_EQ(sample_ltc_polygon(LtcPolygonGeometry<double>{pg, s}, Vec2<double>(0.5, 0.5)).reason, NoSample::kInvalidGeometry);
 }
 
 // ---- MIS ------------------------------------------------------------------------------------------------------

@@ -363,6 +363,30 @@ TEST(ProjectedCapFloat, SamplePdfsNearTheHorizonKeepTheirDigits) {
   EXPECT_GT(worst_naive, 1e4 * eps);  // the check sees what the old lift did
 }
 
+TEST(ProjectedCapFrame, FrameIsHorizontalForALightOverheadUpToRoundingWithATiltedNormal) {
+  // fuzz_projected_cap_double 71db744e (issue 7): normal and direction to the centre agree to rounding (d = r (1 +
+  // 2e-16), a cap of 90 deg), the normal not axis-aligned. Two Gram-Schmidt passes left x parallel to n (x.z = 1,
+  // y = 0) and a sample at n.w = -1; x = n x (w_d x n) is horizontal to rounding.
+  const SphereLightGeometry<double> g{
+      ShadingPoint<double>{Vec3<double>(-1.2669652949151753, 3.4659473398571494, 1.1334826474575876),
+                           Vec3<double>(0.26696529491517529, 0.53393058983035058, -0.13348264745758764)},
+      SphereLight<double>{Vec3<double>(-1, 3.9998779296875, 1), 0.6116943359375}};
+  const auto v = make_projected_cap_view(g);
+  ASSERT_TRUE(v.valid());
+  const double e = std::numeric_limits<double>::epsilon();
+  EXPECT_LE(std::abs(v.x.dot(v.z)), 4 * e);
+  EXPECT_NEAR(v.y.norm(), 1, 4 * e);
+  int valid = 0;
+  for (double u0 : {0.0, 1e-6, 0.3, 0.7, 1.0})
+    for (double u1 : {0.0, 0.25, 0.5, 0.999}) {
+      const auto s = sample_projected_spherical_cap<double>(v, Vec2<double>(u0, u1));
+      if (!s.valid()) continue;
+      ++valid;
+      EXPECT_GE(s.direction.dot(v.z), -4 * e) << u0 << " " << u1;
+    }
+  EXPECT_GE(valid, 16);
+}
+
 TEST(ProjectedCapReference, RingQuadratureMatchesClosedFormsInCase1) {
   // Entirely above the horizon the projected solid angle of a cap is pi sin^2(theta_max) cos(angle to the
   // normal) (the ellipse's area pi r_x r_y): an exact check of the independent ring quadrature.

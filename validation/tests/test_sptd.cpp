@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <numbers>
 #include <random>
 
 #include <boost/math/quadrature/gauss_kronrod.hpp>
@@ -334,6 +335,38 @@ TEST(SptdCaps, ClosedFormCapIntegralsEq10MatchQuadratureOfEq8) {
               return v.valid() ? v.sin_a * v.A : L(0);  // area of E / pi
             }),
             1e-7L);
+}
+
+// The clamped cosine's normaliser, the area of the projected region R (the image cap's projected solid angle),
+// in double where it is small: caps of 1e-2 .. 1e-4 rad straddling the cosine's horizon, against the kernel in
+// long double on the same (exactly widened) cap. R's area moves by at most its height 2 sin(alpha) per unit of
+// abscissa and the abscissae x_c, x0 carry a few eps absolute: tolerance 8 eps 2 sin(alpha) / area + 16 eps.
+// Before the segment form (CosineCapView::seg0) the disk part was a difference of two areas ~pi, off by ~eps pi
+// absolute: measured 1.0e-6 relative at alpha = 1.4e-3 (tolerance 1.4e-8), 2.1e-4 at 1e-4 (found by
+// fuzz_sptd_double, 74048ece...). And caps whose axis lies on the horizon up to rounding (cos t = 1e-300 and
+// cos(pi/2) in double): R is the disk right of x0 = cos(alpha), area alpha - sin(alpha) cos(alpha); the test
+// x0 >= x_c + A for R = E held there up to rounding and gave the area of the degenerate ellipse, 5e-301 and
+// 3e-17 (fuzz_sptd_double, 71c188cc...).
+TEST(SptdCaps, CosineCapAreaIsAccurateInDoubleForSmallCapsAcrossAndOnTheHorizon) {
+  const double e = std::numeric_limits<double>::epsilon();
+  for (double alpha : {1e-2, 1.4e-3, 1e-4})
+    for (double f : {-0.5, 0.5}) {
+      const double t = std::numbers::pi / 2 + f * alpha;
+      const Cap<double> c{Vec3<double>(std::sin(t), 0, std::cos(t)), 2 * std::pow(std::sin(alpha / 2), 2)};
+      const auto v = make_cosine_cap_view(c, Vec3<double>(0, 0, 1));
+      const auto vl = make_cosine_cap_view(Cap<L>{c.axis.cast<L>(), L(c.one_minus_cos)}, Vec3L(0, 0, 1));
+      ASSERT_TRUE(v.valid() && vl.valid() && !v.ellipse_only) << alpha << " " << f;
+      const L tol = 8 * e * 2 * std::sin(L(alpha)) / vl.area + 16 * e;
+      EXPECT_LE(std::abs(v.area / vl.area - 1), tol) << "alpha " << alpha << " t - pi/2 " << f * alpha;
+    }
+  for (double alpha : {24 * std::numbers::pi / 180, 0.3})
+    for (double cos_t : {1e-300, std::cos(std::numbers::pi / 2)}) {
+      const Cap<double> c{Vec3<double>(1, 0, cos_t), 2 * std::pow(std::sin(alpha / 2), 2)};
+      const auto v = make_cosine_cap_view(c, Vec3<double>(0, 0, 1));
+      const L a = std::acos(1 - L(c.one_minus_cos));
+      ASSERT_TRUE(v.valid());
+      EXPECT_NEAR(v.area / double(a - std::sin(a) * std::cos(a)), 1, 1e-12) << "alpha " << alpha << " cos t " << cos_t;
+    }
 }
 
 TEST(SptdCaps, CapIntersectionAppendixBMatchesQuadrature) {
