@@ -341,11 +341,11 @@ TEST(ProjectedCapFloat, SamplePdfsNearTheHorizonKeepTheirDigits) {
   // differs by the float sample's position error (a few eps in the left-area) times the log-derivative of the
   // density, which is large near the horizon (w_z -> 0): for "huge" ~3e-6 at w_z = 0.044 (estimated from the
   // intermediate values; measured 5.3e-6). Measured (20000 samples per configuration, 2026-12-01): at most
-  // 1.05e-5 = 176 eps_float (near-touching, below) in all configurations but near-touching-case3 (4.0e-5); before
-  // the heights, left-areas,
-  // right-areas and r_y^2 - h^2 of projected_cap.h were written without cancellation, 1.5e-4 (tangent-horizon),
-  // 2.9e-4 (case2), 3.2e-4 (huge), and the naive lift of the same samples still gives up to 1 (case3-fig9) and
-  // 3.4 (tiny-straddling: w_x ~ 1 - 1e-6 leaves w_z no digit). Bound: 256 eps_float = 3.1e-5.
+  // 1.05e-5 = 176 eps_float (near-touching, below) in all configurations but near-touching-case3 (4.0e-5). With
+  // only the heights of disk_to_local written without cancellation (not yet the left-areas, right-areas and
+  // r_y^2 - h^2) it was 1.7e-4 (tangent-horizon), 2.9e-4 (case2), 3.2e-4 (huge); the naive lift of the same
+  // samples gives up to 1 (case3-fig9) and 3.4 (tiny-straddling: w_x ~ 1 - 1e-6 leaves w_z no digit). Bound:
+  // 256 eps_float = 3.1e-5.
   // near-touching-case3 (a Case-3 cap of 87 deg): Case 3's w_x = sqrt(1 - w_y^2 - w_z^2) has no
   // cancellation-free form we know; measured 4.0e-5, its stated float error (bound 1e-4). near-touching (d = 1.001
   // r): 1.05e-5, cos(theta_max) = sqrt(1 - (r/d)^2) itself is that far off; inherent for general positions, where
