@@ -214,19 +214,24 @@ SptdReference sptd_reference(const SptdCapGeometry<T>& geo, L delta_c, L rel_sin
     if (r.r > 0) {
       const Vec3<L> p = r.rp / r.r;
       // psi_s carries the relative error of the chord formula's distances |p+- - r_p| (differences of nearly equal
-      // vectors when r_p is close to C's boundary): ~eps_L / |p+- - r_p|; a margin smaller than its error says nothing.
+      // vectors when r_p is close to C's boundary): ~eps_L / |p+- - r_p|, and that of k = (1 - r)(1 + r): r = |r_p|
+      // is rounded to ~eps_L, so k's relative error is ~eps_L / (1 - r) (found by fuzz_sptd_double 3795a46b: 1 - r =
+      // 2.3e-13, psi_s = 2e-3 known to ~1e-9, and p's margin from the image circle, 1.5e-10, decided the orientation
+      // wrongly). A margin smaller than its error says nothing.
       const L eps_l = std::numeric_limits<L>::epsilon();
-      const L psi_s_error = 16 * eps_l * (1 + std::tan(std::min(psi_s, L(1.5))) * (1 / (pp - r.rp).norm() + 1 / (pm - r.rp).norm()));
+      const L psi_s_error = 16 * eps_l * (1 + std::tan(std::min(psi_s, L(1.5))) *
+                                                  (1 / (pp - r.rp).norm() + 1 / (pm - r.rp).norm() + 1 / (1 - r.r)));
       struct Candidate {
         Vec3<L> world, image;
         L image_error;  // of the image point's direction
       };
-      // g(w) in long double: its rounding, eps_L (1 + 2 / rho) as in the header comment for T, plus w's rounding
-      // (eps_L) stretched by k / rho^2 (Eq. 4), the error of k, eps_L / (1 - r) relatively, and Eq. 2's own
-      // cancellation in w.r_p - 1 (>= 1 - r), eps_L / (1 - r).
+      // g(w) in long double by Eq. 2 verbatim, g = (a d - d x c) / (a^2 + |c|^2), a = w.r_p - 1, d = w - r_p,
+      // c = w x r_p; for unit w, a^2 + |c|^2 = rho^2 (rho = |w - r_p|), |a| = (rho^2 + k) / 2 and |c| <= rho, so
+      // absolute errors ~eps_L in a, c and d move g by at most ~eps_L (1 + 1 / rho + k / rho^2) each; w's own
+      // rounding (eps_L) is stretched by k / rho^2 (Eq. 4). (Eq. 2 does not use k.)
       auto computed = [&](const Vec3<L>& w) {
         const L rho = (w - r.rp).norm();
-        return Candidate{w, r.g(w), 16 * eps_l * (1 + 2 / rho + 1 / (1 - r.r) + (r.k / (rho * rho)) * (1 + 1 / (1 - r.r)))};
+        return Candidate{w, r.g(w), 16 * eps_l * (1 + 1 / rho + r.k / (rho * rho))};
       };
       const Candidate candidates[] = {{p, Vec3<L>(-p), 0}, {Vec3<L>(-p), p, 0}, computed(r.axis), computed(Vec3<L>(-r.axis))};
       auto margin = [&](const Candidate& c) {
