@@ -549,5 +549,55 @@ TYPED_TEST(PolygonKernels, ThinPolygonsArePlanarRelativeToTheirWidth) {
   }
 }
 
+// Sec. 3.1 / Fig. 3b: the sectors cover the whole light when an edge of sign 0 lies inside a chain. A triangle
+// with a collinear extra vertex (a doubled vertex 2.2e-16 away, on the same vertical line as the clip point), cut
+// by the horizon: the inner chain used to stop at that edge, A_Sigma 9.3e-22 instead of 1.57e-4 (fuzz_ltc_double
+// c37ad58b with M = I, issue 7).
+TEST(PolygonProjected, ProjectedSolidAngleMatchesLambertWithADoubledVertexInsideAChain) {
+  const PolygonLightGeometry<double> g =
+      geom<double>({-5.6568542494923815, 0.75000000000000122, 0.25}, {0, 2.1588771306901901e-16, -1},
+                   {{0, 1, -2.2204460492503131e-16}, {0, 1, 0}, {0, 1, 1.0000000000000002},
+                    {-2.2204460492503131e-16, -2.2204460492503131e-16, 0}});
+  const auto v = make_polygon_projected_view(g);
+  ASSERT_TRUE(v.valid());
+  const L ref = reference_projected_solid_angle(g.cast<L>());
+  EXPECT_NEAR(v.projected_solid_angle / ref, 1, 1e-12) << v.projected_solid_angle << " vs " << ref;
+}
+
+// Sec. 3.1: a light around the zenith is central although an edge has n_z < 0 by rounding: a doubled vertex
+// (octagon 1a7607a0), a short edge whose line the coordinates do not place to the zenith's side (15bb13cf, x 5e-9
+// beside a vertex); decentral, their A_Sigma was ~1e-33 instead of 0.11 and 1.56 (fuzz_ltc_double with M = I,
+// issue 7).
+TEST(PolygonProjected, ProjectedSolidAngleMatchesLambertAroundTheZenithWithEdgesOfNoiseSign) {
+  const PolygonLightGeometry<double> lights[] = {
+      geom<double>({8.397054999316353, 3.442316484673952, 15.695498354587828},
+                   {-0.63371961421333078, -0.1183730980093587, -0.76445226157620472},
+                   {{-4.9296875, 4.5451574325561523, -3.697265625},
+                    {-3.6039608712328999, 5.1165819667552395, -4.9806448862125396},
+                    {-1.1250764862685814, 1.8165304248345562, -3.8267683034604238},
+                    {-5.3755122339757149, -4.8005260622383839, 4.1802644623999212},
+                    {-5.6531033533779151, -4.928039348358106, 4.4553854581281662},
+                    {-8.7425383850442966, -1.8966136338880655, 3.8969997224885757},
+                    {-6.6763626772667513, 2.9271908803408553, -1.3026657454430708},
+                    {-4.9296875000000009, 4.5451574325561515, -3.6972656249999991}}),
+      geom<double>({66.020560063193827, 0.87677153036454125, 5.4550781250000018},
+                   {-0.65632225384623089, 0.75448068178982353, 2.3282856035237117e-10},
+                   {{66.252363324165344, 0.61030018329620361, 10.91015625},
+                    {66.020560067073461, 0.87677153373943217, 5.4550781250000018},
+                    {65.4609375, 1.5200902819633484, 0},
+                    {64.901314932926539, 2.1634090301872648, -2.259567343179794},
+                    {64.669511675834656, 2.4298803806304932, -6.6805439648799951e-16},
+                    {64.901314932926539, 2.1634090301872648, 5.4550781249999991},
+                    {65.4609375, 1.5200902819633486, 10.91015625},
+                    {66.020560067073461, 0.87677153373943228, 13.169723593179794}})};
+  for (const auto& g : lights) {
+    const auto v = make_polygon_projected_view(g);
+    ASSERT_TRUE(v.valid());
+    EXPECT_TRUE(v.central);
+    const L ref = reference_projected_solid_angle(g.cast<L>());
+    EXPECT_NEAR(v.projected_solid_angle / ref, 1, 1e-12) << v.projected_solid_angle << " vs " << ref;
+  }
+}
+
 }  // namespace
 }  // namespace warpcheck
