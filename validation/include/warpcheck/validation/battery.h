@@ -109,9 +109,11 @@ QuadratureResult integrate_adaptive(const std::function<Real(Real)>& f, Real a, 
 // near-singular lost 0.23% of the mass with 1 panel, none with one per chi-square ring).
 QuadratureResult integrate_cap_region_with_error(const std::function<Real(const Vec3L&)>& f, const Cap<Real>& cap,
                                                  Real t0, Real t1, Real phi0, Real phi1, Real tol = 1e-10L,
-                                                 int azimuth_panels = 1, int radial_panels = 1);
+                                                 int azimuth_panels = 1, int radial_panels = 1,
+                                                 const std::vector<Vec3L>& boundary_planes = {});
 Real integrate_cap_region(const std::function<Real(const Vec3L&)>& f, const Cap<Real>& cap, Real t0, Real t1,
-                          Real phi0, Real phi1, Real tol = 1e-10L, int azimuth_panels = 1, int radial_panels = 1);
+                          Real phi0, Real phi1, Real tol = 1e-10L, int azimuth_panels = 1, int radial_panels = 1,
+                          const std::vector<Vec3L>& boundary_planes = {});
 
 // The direction with coordinates (t, phi) in the cap's frame, and back.
 Vec3L cap_direction(const Cap<Real>& cap, Real t, Real phi);
