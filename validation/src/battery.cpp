@@ -208,6 +208,10 @@ QuadratureResult integrate_cap_region_with_error(const std::function<Real(const 
   // at an acute corner whose sides run nearly radially, the lines cross the support only within a sliver of
   // azimuth around the corner's, which the outer rule's nodes would step over.
   std::vector<Real> phi_cuts{phi0, phi1};
+  auto add_phi_cut = [&](Real phi) {  // phi in (-2 pi, 2 pi), kept when inside the region's azimuth range
+    if (phi < 0) phi += kTwoPi<Real>;
+    if (phi > phi0 && phi < phi1) phi_cuts.push_back(phi);
+  };
   for (std::size_t i = 0; i < boundary_planes.size(); ++i)
     for (std::size_t j = i + 1; j < boundary_planes.size(); ++j) {
       const Vec3L p = boundary_planes[i].cross(boundary_planes[j]);
@@ -216,9 +220,7 @@ QuadratureResult integrate_cap_region_with_error(const std::function<Real(const 
         const Vec3L l = fr.to_local(q);
         const Real t = (1 - l.z()) / omc_cap;
         if (!(t >= t0 && t <= t1)) continue;
-        Real phi = std::atan2(l.y(), l.x());
-        if (phi < 0) phi += kTwoPi<Real>;
-        if (phi > phi0 && phi < phi1) phi_cuts.push_back(phi);
+        add_phi_cut(std::atan2(l.y(), l.x()));
       }
     }
   // And where a boundary circle crosses the region's inner or outer ring (polar angle theta_c): between these
@@ -235,11 +237,7 @@ QuadratureResult integrate_cap_region_with_error(const std::function<Real(const 
       const Real sin_c = std::sqrt(std::max<Real>(0, (1 - cos_c) * (1 + cos_c)));
       const Real arg = -ml.z() * cos_c / (sin_c * rho);
       if (!(std::abs(arg) <= 1)) continue;
-      for (Real sign : {Real(-1), Real(1)}) {
-        Real phi = std::fmod(psi + sign * std::acos(arg), kTwoPi<Real>);
-        if (phi < 0) phi += kTwoPi<Real>;
-        if (phi > phi0 && phi < phi1) phi_cuts.push_back(phi);
-      }
+      for (Real sign : {Real(-1), Real(1)}) add_phi_cut(std::fmod(psi + sign * std::acos(arg), kTwoPi<Real>));
     }
   }
   std::sort(phi_cuts.begin(), phi_cuts.end());

@@ -1,8 +1,8 @@
 // Polygon-light kernels (Peters 2021 and the published baselines) and their named configurations.
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <functional>
+#include <utility>
 #include <vector>
 
 #include "warpcheck/polygon_projected.h"
@@ -26,32 +26,25 @@ template <class T> Cap<T> cap_of_polygon(const PolygonLightGeometry<T>& g) {
   return bounding_cap_of_directions(w.data(), g.light.count);
 }
 
-// The great circles on which the kernels' pdfs jump or kink, for the battery's quadrature
-// (SamplerUnderTest::boundary_planes): the planes through x and each edge, and the horizon (where the clipped
-// kernels' supports end and the projected density's cosine reaches 0).
-std::vector<Vec3L> boundary_planes(const PolygonLightGeometry<Real>& g) {
+// Unit normals of the planes through x and each edge (degenerate edges skipped).
+std::vector<Vec3L> edge_planes(const PolygonLightGeometry<Real>& g) {
   std::vector<Vec3L> planes;
   const int n = g.light.count;
   for (int i = 0; i < n; ++i) {
     const Vec3L e = (g.light.vertices[i] - g.shading.position).cross(g.light.vertices[(i + 1) % n] - g.shading.position);
     if (e.norm() > 0) planes.push_back(e.normalized());
   }
-  if (g.shading.normal.norm() > 0) planes.push_back(g.shading.normal.normalized());
   return planes;
 }
 
 // The angular width of the polygon seen from x: for a convex spherical polygon, the smallest over its edges of
 // the largest angular distance of a vertex from the edge's great circle (a polygon seen 0.3 deg from its plane:
 // 2.7e-3 rad, in a bounding cap of 0.32 rad).
-Real angular_width(const PolygonLightGeometry<Real>& g) {
-  const int n = g.light.count;
+Real angular_width(const PolygonLightGeometry<Real>& g, const std::vector<Vec3L>& edges) {
   Real width = kPi<Real>;
-  for (int i = 0; i < n; ++i) {
-    const Vec3L e = (g.light.vertices[i] - g.shading.position).cross(g.light.vertices[(i + 1) % n] - g.shading.position);
-    if (!(e.norm() > 0)) continue;
-    const Vec3L m = e.normalized();
+  for (const Vec3L& m : edges) {
     Real far = 0;
-    for (int j = 0; j < n; ++j)
+    for (int j = 0; j < g.light.count; ++j)
       far = std::max(far, std::asin(std::min<Real>(1, std::abs(m.dot((g.light.vertices[j] - g.shading.position).normalized())))));
     width = std::min(width, far);
   }
@@ -294,7 +287,13 @@ void add_case(Registry& r, const char* kernel, const PolygonConfig& c, Measure m
     // float pdf's jumps lie off the long double planes, likely the cause), and the default nodes already resolve
     // every other configuration (the double battery of 9ec2b69 passed them all).
     const Real theta_max = std::acos(std::clamp<Real>(1 - s.bounding_cap.one_minus_cos, -1, 1));
-    if (angular_width(c.g) < theta_max / 16) s.boundary_planes = boundary_planes(c.g);
+    // The great circles on which the pdfs jump or kink: the edges' planes and the horizon (where the clipped
+    // kernels' supports end and the projected density's cosine reaches 0).
+    std::vector<Vec3L> planes = edge_planes(c.g);
+    if (angular_width(c.g, planes) < theta_max / 16) {
+      if (c.g.shading.normal.norm() > 0) planes.push_back(c.g.shading.normal.normalized());
+      s.boundary_planes = std::move(planes);
+    }
     if (s.expect_no_sample || measure == Measure::kNone) return s;
     Normalization n;
     n.kernel = [g = c.g.template cast<T>()] { return Real(K<T>::normaliser(g)); };
