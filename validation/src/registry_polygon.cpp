@@ -251,8 +251,27 @@ std::vector<PolygonConfig> configs() {
 //    unresolved (the warp's finite differences at steps h and 2h disagree), 7.3e-7 where resolved.
 //  * Arvo 1995 as published on tiny distant lights (Peters 2021 Sec. 5 and Fig. 7: its solid-angle inversion
 //    cancels): measured in double pdf-consistency 6.7e-4 (far-1cm) and 1 (far-1mm: samples outside the light).
+//  * float on the 1 mm light 40 m away (Fig. 7b), every kernel: float's unit vectors near its direction are 6e-8
+//    rad apart, 1/426 of the light's 2.5e-5 rad width (1/4262 at 1 cm), so sampled directions lie on a lattice
+//    the battery's bins resolve at 1e7 samples, and some round to just outside the light. Measured on Turk (float
+//    arithmetic only where it samples a point and normalises; test
+//    PolygonFloat.DirectionsToTheOneMillimetreLightLieOnALattice, 1e6 samples): 343292 distinct directions,
+//    541 samples with pdf(direction) = 0; at 1 cm 984300 distinct and 49. Battery (float,
+//    1e7): chi2 and KS p < 1e-45 for every kernel, pdf-consistency 1 (a sample's direction outside the light).
+//    Peters 2021 Sec. 3.7 recommends area sampling here; in float that is no cure either.
+//  * Arvo 1995 and Urena et al. 2013 in float on both far lights: their solid angles (angle sums minus pi resp.
+//    2 pi) cancel: 1 cm, 0 (Arvo: no samples) and -2.4e-7 (Urena) for 5.3e-8 sr; 1 mm, 0 and 2.4e-7 for 5.3e-10.
 const char* polygon_known_limitation(const std::string& kernel, const std::string& scalar, const std::string& config) {
   if (config == "below-horizon") return "";
+  if (scalar == "float" && (config == "far-1cm" || config == "far-1mm") && (kernel == "baseline-arvo-triangle" || kernel == "baseline-urena-rectangle"))
+    return "as published, the baseline's solid angle (a sum of angles minus pi or 2 pi) cancels in float on the 1 cm "
+           "and 1 mm lights 40 m away (1 cm: Arvo 0, i.e. no samples, Urena -2.4e-7 for 5.3e-8 sr; 1 mm: Arvo 0, Urena 2.4e-7 "
+           "for 5.3e-10); a baseline, not fixed";
+  if (scalar == "float" && config == "far-1mm" && kernel != "polygon-projected-solid-angle-biased")
+    return "float cannot resolve a 1 mm light 40 m away (Peters 2021 Fig. 7b): its unit vectors there are 6e-8 rad "
+           "apart, 1/426 of the light's width, so samples lie on a lattice the bins resolve at 1e7 samples (chi2, KS) "
+           "and some round to just outside the light (pdf 0: pdf-consistency 1); measured on Turk: 343292 distinct "
+           "directions and 541 outside in 1e6 samples; see registry_polygon.cpp";
   if (kernel == "polygon-projected-solid-angle-biased")
     return "biased by design (Peters 2021 Sec. 6.4: no iteration, arctangent approximated to 1.2e-5 rad); the "
            "battery is expected to see the bias at 1e7 samples (double: chi2 p = 0 straddling-horizon, "

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cstdio>
 #include <random>
 #include <vector>
@@ -601,12 +602,14 @@ TEST(PolygonProjected, ProjectedSolidAngleMatchesLambertAroundTheZenithWithEdges
 
 // Sec. 3.7 / Fig. 7a: "even with small, distant polygons, it still works" in float. The 1 cm square light 40 m
 // away (the battery's far-1cm) sampled with float has sectors 2e-4 rad wide whose inner and outer ellipses are
-// 2.5e-4 apart relative; Eq. 6's root taken from T's entries (Blinn's formula) moved by their rounding, and the
-// samples lay up to 0.43 light widths from the exact inverse for the same u (chi2 p = 0 at 1e7 samples), the
-// same with 20 iterations. The root found around the current direction (increasing_root_around) leaves 1.2e-3
-// widths (measured); the bound 1e-2 is above the float area function's own error (5e-4 of a sector's area at
-// its tips, measured), far below the defect. The reference is long double on the same (float-rounded) light.
-TEST(PolygonProjected, FloatSamplesOfASmallFarLightStayWithinAHundredthOfItsWidthOfTheExactInverse) {
+// 2.5e-4 apart relative. Two defects this test caught (float, distance to the exact inverse for the same u, in
+// light widths): Eq. 6's root taken from T's entries (Blinn's formula) moved by their rounding, up to 0.43 on
+// the grid, the same with 20 iterations (now increasing_root_around); and the residual measured from s0 could not
+// resolve the last sector's tip, 1.7e-2 at u0 = 1 - 1e-4 (chi2 bin +18 sigma at 1e7 samples; now from the
+// nearer end, decentral_residual). Measured after both: 6.3e-4 worst, grid and ends.
+// The bound 5e-3 leaves room for the float area function's own error (5e-4 of a sector's area, measured).
+// The reference is long double on the same (float-rounded) light.
+TEST(PolygonProjected, FloatSamplesOfASmallFarLightStayWithinHalfAPercentOfItsWidthOfTheExactInverse) {
   const L side = 0.01L;
   const Vec3<L> c(20, 10, 32.4L), a(1, 0, 0), b(0, 1, 0);
   const PolygonLightGeometry<float> gf = geom<L>(Vec3<L>::Zero(), Vec3<L>(0, 0, 1),
@@ -619,16 +622,57 @@ TEST(PolygonProjected, FloatSamplesOfASmallFarLightStayWithinAHundredthOfItsWidt
   ASSERT_FALSE(vl.central);  // the decentral iteration is what is tested
   const L width = side / c.norm();
   L worst = 0;
-  for (int i = 0; i < 64; ++i)
+  std::vector<L> u0s;  // a grid, and the ends of the range, where the first and last sectors taper to corners
+  for (int i = 0; i < 64; ++i) u0s.push_back((i + 0.5L) / 64);
+  for (L e : {1e-3L, 1e-4L, 1e-5L}) u0s.push_back(e), u0s.push_back(1 - e);
+  for (const L u0 : u0s)
     for (int j = 0; j < 8; ++j) {
-      const L u0 = (i + 0.5L) / 64, u1 = (j + 0.5L) / 8;
+      const L u1 = (j + 0.5L) / 8;
       const auto sf = sample_polygon_projected_solid_angle(vf, Vec2<float>(float(u0), float(u1)));
       const auto sl = sample_polygon_projected_solid_angle(vl, Vec2<L>(u0, u1), 6);
       ASSERT_TRUE(sf.valid() && sl.valid());
       worst = std::max(worst, (sf.direction.cast<L>() - sl.direction).norm() / width);
     }
   std::printf("[ far 1 cm light, float ] worst distance to the exact inverse: %.2Le light widths\n", worst);
-  EXPECT_LE(worst, 1e-2L);
+  EXPECT_LE(worst, 5e-3L);
+}
+
+// The float limit behind the battery's far-1mm failures (registry_polygon.cpp, polygon_known_limitation): float's
+// unit vectors near the direction of a light 40 m away are 6e-8 rad apart, 1/426 of a 1 mm light's width, so
+// even Turk's area sampling (float only in the point and its normalisation) returns directions on a coarse
+// lattice, and some round to just outside the light. At 1 cm the lattice is 10x finer and nearly every sample
+// is distinct. Measured (seed 1, 1e6 samples): 1 mm 343292 distinct, 541 with pdf 0; 1 cm 984300 and 49.
+TEST(PolygonFloat, DirectionsToTheOneMillimetreLightLieOnALattice) {
+  auto far_square = [](L side) {
+    const Vec3<L> c(20, 10, 32.4L), a(1, 0, 0), b(0, 1, 0);
+    return geom<L>(Vec3<L>::Zero(), Vec3<L>(0, 0, 1),
+                   {c - side / 2 * a - side / 2 * b, c + side / 2 * a - side / 2 * b, c + side / 2 * a + side / 2 * b,
+                    c - side / 2 * a + side / 2 * b})
+        .cast<float>();
+  };
+  auto measure = [](const PolygonLightGeometry<float>& g, std::size_t* distinct, int* outside) {
+    std::mt19937_64 rng(1);
+    std::uniform_real_distribution<float> U(0, 1);
+    std::vector<std::array<float, 3>> dirs;
+    *outside = 0;
+    for (int i = 0; i < 1000000; ++i) {
+      const auto s = sample_turk_area(g, Vec2<float>(U(rng), U(rng)));
+      if (!s.valid()) continue;
+      dirs.push_back({s.direction.x(), s.direction.y(), s.direction.z()});
+      *outside += !(pdf_turk_area(g, s.direction) > 0);
+    }
+    std::sort(dirs.begin(), dirs.end());
+    *distinct = std::size_t(std::unique(dirs.begin(), dirs.end()) - dirs.begin());
+  };
+  std::size_t d_mm, d_cm;
+  int o_mm, o_cm;
+  measure(far_square(0.001L), &d_mm, &o_mm);
+  measure(far_square(0.01L), &d_cm, &o_cm);
+  std::printf("[ float, Turk, 1e6 samples ] 1 mm light: %zu distinct directions, %d outside; 1 cm: %zu, %d\n", d_mm, o_mm,
+              d_cm, o_cm);
+  EXPECT_LT(d_mm, 500000u);  // a lattice: most samples share their direction with another
+  EXPECT_GT(o_mm, 0);
+  EXPECT_GT(d_cm, 950000u);  // 10x finer: nearly all distinct
 }
 
 }  // namespace
