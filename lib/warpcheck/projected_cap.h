@@ -247,10 +247,46 @@ template <class T> struct ProjectedCapView {
   T projected_solid_angle_if_uniform() const { return which_case <= 2 ? total : T(0); }
 };
 
+namespace projected_cap_detail {
+
+// Scale invariance (our change, not in the paper). Alg. 1 reads the light only through w_d = d / |d| and
+// r_y = r / |d|, d = c - x, which do not change when d and r are multiplied by the same power of two; that product
+// is exact (barring underflow). make_sphere_view forms |d|, d / |d| and r / |d| in T, which is accurate for d in
+// T's normal range but not for subnormal coordinates, where every intermediate carries an absolute rounding of
+// denorm_min / 2: d = (1, 3, -1) denorm_min has |d| = sqrt(11) denorm_min, rounded to 3 denorm_min, so w_d came
+// out of length 1.106 and r_y = 2/3 instead of 0.603 (fuzz_projected_cap_double 07252d59, 8df1478e, issue 7).
+// The view is therefore built from x' = 0, c' = d 2^-e and r' = r 2^-e with |d|_inf in [1/2, 1): every later
+// quantity (|d'|, r' / |d'|, squares) is of unit scale, whatever the coordinates' magnitude (subnormal, or ~1e209
+// where |d|^2 overflows). d itself is formed in T from the inputs, as before: its rounding is the input's
+// conditioning (exact when the difference is subnormal). r' is capped at 4 (> |d'| <= sqrt(3): x inside the light
+// either way, no overflow) and at least denorm_min (r' / |d'| then squares to 0: kTooSmall, as unscaled).
+// Returns the exponent e (0 where the geometry is passed on unchanged for make_sphere_view to reject).
+template <class T> int unit_scale_geometry(const SphereLightGeometry<T>& g, SphereLightGeometry<T>& out) {
+  out = g;
+  const T r = g.light.radius;
+  if (!all_finite(g.light.center) || !all_finite(g.shading.position) || !std::isfinite(r) || !(r > T(0))) return 0;
+  const Vec3<T> d = g.light.center - g.shading.position;
+  if (!all_finite(d)) return 0;  // the difference overflowed
+  const T m = d.cwiseAbs().maxCoeff();
+  if (!(m > T(0))) return 0;  // x at the centre: inside the light
+  int e = 0, er = 0;
+  std::frexp(m, &e);
+  std::frexp(r, &er);  // r < 2^er
+  out.shading.position = Vec3<T>::Zero();
+  out.light.center = Vec3<T>(std::ldexp(d.x(), -e), std::ldexp(d.y(), -e), std::ldexp(d.z(), -e));
+  out.light.radius = er - e > 2 ? T(4) : std::max(std::ldexp(r, -e), std::numeric_limits<T>::denorm_min());
+  return e;
+}
+
+}  // namespace projected_cap_detail
+
 template <class T> ProjectedCapView<T> make_projected_cap_view(const SphereLightGeometry<T>& g) {
   ProjectedCapView<T> p;
-  p.sphere = make_sphere_view(g);
+  SphereLightGeometry<T> unit;
+  const int scale_exponent = projected_cap_detail::unit_scale_geometry(g, unit);
+  p.sphere = make_sphere_view(unit);
   if (!p.sphere.valid()) return p.reason = p.sphere.reason, p;
+  p.sphere.distance = std::ldexp(p.sphere.distance, scale_exponent);  // |c - x| in the caller's units
   const SphereView<T>& s = p.sphere;
   const Vec3<T> wd = s.frame.z;
   p.z = s.normal;

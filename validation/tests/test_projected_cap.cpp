@@ -387,6 +387,48 @@ TEST(ProjectedCapFrame, FrameIsHorizontalForALightOverheadUpToRoundingWithATilte
   EXPECT_GE(valid, 16);
 }
 
+// ---- Scale and the Case-3 lift (issue 7) ---------------------------------------------------------------------
+
+TEST(ProjectedCapScale, SubnormalAndHugeLightsSampleExactlyLikeTheSameLightAtUnitScale) {
+  // The sampler depends on the light only through w_d and r / |c - x|, both unchanged when c - x and r are
+  // multiplied by a power of two. A light at 2^-1074 (c - x = (1, 3, -1) denorm_min, fuzz_projected_cap_double
+  // 07252d59: |c - x| rounded to 3 denorm_min gave |w_d| = 1.106 and A_E + A_D 40 % off; before the fix all 15
+  // samples of each normal below differed) and one at 2^900 (where |c - x|^2 would overflow; stableNorm avoided
+  // that already, and those passed before) must give bit-identical views, samples and densities to the unit-scale light: every
+  // coordinate below is an integer times the scale, so c - x is exact at each scale, and the view is built from
+  // (c - x) 2^-e, r 2^-e (unit_scale_geometry) in all three.
+  const Vec3<double> c0(0, 3, 3), x0(-1, 0, 4);
+  const Vec3<double> wd = (c0 - x0).normalized(), side = Vec3<double>(1, 0, 1).normalized();  // side . wd = 0
+  int cases_seen[4] = {0, 0, 0, 0};
+  for (double h : {0.9, 0.3, 0.0, -0.2, -0.55}) {  // r_y = 2 / sqrt(11) = 0.603: Cases 1, 2, 2, 3, 3
+    const Vec3<double> n = wd * h + side * std::sqrt(1 - h * h);
+    const SphereLightGeometry<double> unit{ShadingPoint<double>{x0, n}, SphereLight<double>{c0, 2}};
+    const ProjectedCapView<double> vu = make_projected_cap_view(unit);
+    ASSERT_TRUE(vu.valid()) << h;
+    ++cases_seen[vu.which_case];
+    for (int exponent : {-1074, -1000, 900}) {
+      const double k = std::ldexp(1.0, exponent);
+      const SphereLightGeometry<double> g{ShadingPoint<double>{x0 * k, n}, SphereLight<double>{c0 * k, 2 * k}};
+      const ProjectedCapView<double> v = make_projected_cap_view(g);
+      ASSERT_TRUE(v.valid()) << h << " " << exponent;
+      EXPECT_EQ(v.which_case, vu.which_case);
+      EXPECT_EQ(v.sphere.frame.z, vu.sphere.frame.z) << h << " " << exponent;
+      EXPECT_EQ(v.total, vu.total) << h << " " << exponent;
+      for (double u0 : {0.0, 1e-9, 0.3, 0.7, 1 - 1e-9})
+        for (double u1 : {1e-6, 0.5, 0.9}) {
+          const auto a = sample_projected_spherical_cap<double>(v, Vec2<double>(u0, u1));
+          const auto b = sample_projected_spherical_cap<double>(vu, Vec2<double>(u0, u1));
+          ASSERT_EQ(a.valid(), b.valid());
+          if (!a.valid()) continue;
+          EXPECT_EQ(a.direction, b.direction) << h << " " << exponent << " " << u0 << " " << u1;
+          EXPECT_EQ(a.pdf, b.pdf) << h << " " << exponent << " " << u0 << " " << u1;
+          EXPECT_EQ(pdf_projected_spherical_cap<double>(v, a.direction), pdf_projected_spherical_cap<double>(vu, a.direction));
+        }
+    }
+  }
+  EXPECT_GT(cases_seen[1] * cases_seen[2] * cases_seen[3], 0);
+}
+
 TEST(ProjectedCapReference, RingQuadratureMatchesClosedFormsInCase1) {
   // Entirely above the horizon the projected solid angle of a cap is pi sin^2(theta_max) cos(angle to the
   // normal) (the ellipse's area pi r_x r_y): an exact check of the independent ring quadrature.
