@@ -558,9 +558,18 @@ template <class T, CutDiskInverse M> T pdf_local(const ProjectedCapView<T>& p, c
     T dx, dy, hh, area;
     if (!local_to_disk(p, pc.kind, w, dx, dy, hh, area)) continue;
     const CutDiskPreimage<T> pre = cut_disk_preimage<T, M>(dx, hh);
-    const T a_lo = std::min(piece_left_area(pc, pc.u_lo), piece_left_area(pc, pc.u_hi));
-    const T a_hi = std::max(piece_left_area(pc, pc.u_lo), piece_left_area(pc, pc.u_hi));
-    if (pre.left_area < a_lo || pre.left_area > a_hi) continue;
+    // A piece a = beta u0 (alpha = 0) covers left-areas [0, beta u_hi], i.e. right-areas >= right_hi; compared as
+    // right-areas, because its end is near pi, where left-areas lose the cut: a Case-2 disk piece of area 6.4e-16
+    // lies within one ulp of pi (4.4e-16) in left-area, so the ellipse piece claimed all of it and pdf() returned
+    // the ellipse's density there (sample pdf 0.55 x pdf(direction), tau = 1 - 2^-53 for a share of 2.0e-16;
+    // confirming campaign of issue 7, 2026-12-02). The other pieces (a = alpha (1 - u0) <= pi/2) keep left-areas.
+    if (pc.alpha == T(0)) {
+      if (pre.right_area < pc.right_hi) continue;
+    } else {
+      const T a_lo = std::min(piece_left_area(pc, pc.u_lo), piece_left_area(pc, pc.u_hi));
+      const T a_hi = std::max(piece_left_area(pc, pc.u_lo), piece_left_area(pc, pc.u_hi));
+      if (pre.left_area < a_lo || pre.left_area > a_hi) continue;
+    }
     if (u) {
       (*u)[0] = std::clamp(pc.alpha == T(0) ? pre.left_area / pc.beta : T(1) - pre.left_area / pc.alpha, pc.u_lo, pc.u_hi);
       (*u)[1] = hh > T(0) ? std::clamp((dy / hh + T(1)) / T(2), T(0), T(1)) : T(0.5);

@@ -466,6 +466,35 @@ TEST(ProjectedCapCase3, SamplePdfsKeepTheirDigitsNearTheLunesFlatSide) {
   }
 }
 
+TEST(ProjectedCapInverse, PdfGivesACase2DiskPieceBelowALeftAreaUlpItsOwnDensity) {
+  // Confirming campaign of issue 7 (fuzz_projected_cap_double 30c73384): an overhead light touching x (h = r_y =
+  // 1 - 5.7e-14 up to 1e-16), Case 2 with a disk piece of area A_D = 6.4e-16 (half-cap of 9.9e-6 rad around the
+  // local x axis), less than two ulps of pi in left-area, and tau = 1 - 2^-53 (the quintic's disk piece then has
+  // 0.55 x the ellipse's density: its u0 share is quantised). pdf() compared the ellipse piece's left-areas near pi
+  // and gave the ellipse's density to 29 of the 50 directions below (theta in [0.5, 1) of the piece's radius, the
+  // outer part); it compares right-areas now. Every one must get the disk piece's density, the sampler's.
+  const SphereLightGeometry<double> g{
+      ShadingPoint<double>{Vec3<double>(-8.9672072669915119e+26, 8.7416627936820459e+26, -1.4445920849195454e+26),
+                           Vec3<double>(-3.1900322795701238e-07, -0.70833782255786737, -0.70587359288606144)},
+      SphereLight<double>{Vec3<double>(-8.9672072669915119e+26, 7.5697645773807265e+26, -2.6124131383234877e+26),
+                          1.6544338736085515e+26}};
+  const auto v = make_projected_cap_view(g);
+  ASSERT_EQ(v.which_case, 2);
+  ASSERT_LT(v.area_d, 2 * (kPi<double> - std::nextafter(kPi<double>, 0.0)));
+  const auto s = sample_projected_spherical_cap<double>(v, Vec2<double>(std::nextafter(1.0, 0.0), 0.5));  // disk piece
+  ASSERT_TRUE(s.valid());
+  const double disk = s.pdf / v.to_local(s.direction).z();  // per projected solid angle, constant on the piece
+  const double theta_t = std::acos(v.t_x);
+  for (int i = 0; i < 50; ++i) {
+    const double th = (0.5 + 0.01 * i) * theta_t, y = std::sin(th) / std::sqrt(2.0);
+    const Vec3<double> w = v.to_world(Vec3<double>(std::cos(th), y, y));
+    const double p = pdf_projected_spherical_cap<double>(v, w) / v.to_local(w.normalized()).z();
+    // The quintic's density factor varies by ~g' e <= 1e-15 over a piece of left-areas e <= 6.4e-16, the
+    // ellipse's density is 1.8 x the disk piece's: 1e-6 separates them with room for the direction's rounding.
+    EXPECT_NEAR(p / disk, 1, 1e-6) << i;
+  }
+}
+
 TEST(ProjectedCapReference, RingQuadratureMatchesClosedFormsInCase1) {
   // Entirely above the horizon the projected solid angle of a cap is pi sin^2(theta_max) cos(angle to the
   // normal) (the ellipse's area pi r_x r_y): an exact check of the independent ring quadrature.
