@@ -328,7 +328,10 @@ template <class P, class T = P> L kappa_of(const Vec3<P>* v, int n, const Vec3<P
 // not the cone of its convex hull; a hull in the noise plane of such a sliver is not meaningful either, see
 // fuzz/README.md, "Known limits".)
 // P: the vertices' type (T, or L for a displaced light computed in long double); T: the kernel's precision.
-template <class P, class T = P> L polygon_cone_margin(const PolygonLight<P>& p, const Vec3<P>& x, const Vec3<P>& w) {
+// edges: the edge vectors V_{j+1} - V_j if the caller has them more accurately than the vertices' difference (a
+// displaced light whose vertices are rounded, common_polygon.h); null: the difference.
+template <class P, class T = P>
+L polygon_cone_margin(const PolygonLight<P>& p, const Vec3<P>& x, const Vec3<P>& w, const Vec3<L>* edges = nullptr) {
   const int n = p.count;
   const Vec3<L> xl = x.template cast<L>(), wl = w.template cast<L>().normalized();
   Vec3<L> area = Vec3<L>::Zero();
@@ -340,7 +343,7 @@ template <class P, class T = P> L polygon_cone_margin(const PolygonLight<P>& p, 
     L margin = std::numeric_limits<L>::infinity();
     for (int j = 0; j < n; ++j) {
       const Vec3<L> pj = p.vertices[j].template cast<L>() - xl;
-      const Vec3<L> ej = p.vertices[(j + 1) % n].template cast<L>() - p.vertices[j].template cast<L>();
+      const Vec3<L> ej = edges ? edges[j] : Vec3<L>(p.vertices[(j + 1) % n].template cast<L>() - p.vertices[j].template cast<L>());
       const Vec3<L> m = kahan_cross<L>(pj, ej);  // = p_j x p_{j+1}
       const L mn = m.norm();
       if (!(mn > 0)) continue;  // x on the edge's line: that bound is undetermined

@@ -159,8 +159,18 @@ template <class T> PolygonMargins polygon_margins(const PolygonLightGeometry<T>&
         off = std::max(off, std::abs(d));
         flat.vertices[i] = vi - d * nh;
       }
+      // The flat light's edges flat_{j+1} - flat_j = e_j - (nh.e_j) nh, e_j = V_{j+1} - V_j (the d_j differ by
+      // nh.e_j), from the exact differences e_j: the difference of the rounded flat vertices leaves a short edge
+      // tilted out of the plane by eps_L |V| / |e_j|, and seen from x close to the plane its edge plane then
+      // cuts through the light (found by fuzz_ltc_double with M = I, 9e426f21: an edge of 2.2e-13 at |V| ~ 3,
+      // tilt 1.5e-6, x 1e-13 from the plane, a sample at -8.1e-10 against that plane; issue 7).
+      std::array<Vec3<L>, kMaxPolygonVertices> fe;
+      for (int i = 0; i < n; ++i) {
+        const Vec3<L> ei = g.light.vertices[(i + 1) % n].template cast<L>() - g.light.vertices[i].template cast<L>();
+        fe[i] = ei - nh.dot(ei) * nh;
+      }
       if (off > 0 && off <= delta / 2)
-        mm = std::max(mm, polygon_cone_margin<L, T>(flat, xl, Vec3<L>(w.template cast<L>())));
+        mm = std::max(mm, polygon_cone_margin<L, T>(flat, xl, Vec3<L>(w.template cast<L>()), fe.data()));
     }
   }
   if (clipped) {

@@ -43,6 +43,13 @@ template <class T> struct LtcPolygonView {
   Mat3<T> m = Mat3<T>::Identity(), m_inv = Mat3<T>::Identity();
   T det = T(1), det_inv = T(1);
   PolygonProjectedView<T> transformed;  // M^-1 P, seen from the origin with normal z, clipped to z >= 0
+  // pdf()'s test "w in P", in world space (polygon_inward_planes): M^-1 w is in the cone of M^-1 P iff w is in P's,
+  // but the transformed cone's planes come from rounded vertices M^-1 (V - x), whose differences lose a short
+  // edge's direction (found by fuzz_ltc_double, 834135fe: vertices 3e51 apart at 2e67 were both snapped onto the
+  // horizon, the edge's plane became the horizon with an orientation of rounding noise, pdf 0 at samples 0.09
+  // rad inside; issue 7). The world edges V_{j+1} - V_j are exact.
+  std::array<Vec3<T>, kMaxPolygonVertices> inward{};
+  int planes = 0;
   T integral = 0;                       // int_P p_M = A_Sigma(M^-1 P) / pi (Eq. 10)
 
   bool valid() const { return reason == NoSample::kNone; }
@@ -69,6 +76,7 @@ template <class T> LtcPolygonView<T> make_ltc_polygon_view(const LtcPolygonGeome
   if (!pv.valid()) return v.reason = pv.reason, v;
   if (!g.m.allFinite()) return v.reason = NoSample::kNonFinite, v;
   v.frame = pv.frame;
+  v.planes = polygon_inward_planes(g.polygon, pv, v.inward.data());
   v.m = g.m;
   // |M| > 0 (Sec. 4.1). A singular or reflecting M has no LTC; an M whose inverse overflows neither. One
   // determinant for the test and the inverse: inverse() divides by its own cofactor expansion, which can be 0
@@ -85,15 +93,26 @@ template <class T> LtcPolygonView<T> make_ltc_polygon_view(const LtcPolygonGeome
   return v;
 }
 
+// pdf(w) = pdf_projected(c) |M c|^3 / |M| at c = M^-1 w / |M^-1 w| (the sampler's Jacobian, with |M^-1 w| = 1 / |M c|).
+// |M c| from M itself, not 1 / |Minv_T w|: the computed inverse is Minv_T = M^-1 (I + E) with |E| up to eps cond(M),
+// so Minv_T w = M^-1 w' for a w' = (I + E) w that is turned by up to |E| (harmless: the density is smooth) and
+// stretched by up to |E|, which 1 / |Minv_T w|^3 turns into a relative error of 3 |E| of the density (found by
+// fuzz_ltc_double, b98e6f95: cond(M) 1024, |E| 8.9e-14, sample pdf and pdf(direction) 8.3e-14 apart = 3 (E w).w;
+// issue 7). c depends only on the direction of w', and |M c| = |w'| / |Minv_T w|: the density at w' / |w'| exactly.
 template <class T> T pdf_ltc_polygon(const LtcPolygonView<T>& v, const Vec3<T>& w) {
   if (!v.valid() || !all_finite(w)) return T(0);
   const T len = w.norm();
   if (!(len > T(0))) return T(0);
+  for (int j = 0; j < v.planes; ++j)
+    if (v.inward[j].dot(w) < T(0)) return T(0);
   const Vec3<T> o = v.m_inv * Vec3<T>(v.frame.to_local(w) / len);
   const T olen = o.norm();
-  if (!(olen > T(0))) return T(0);
-  const T pc = pdf_polygon_projected_solid_angle(v.transformed, Vec3<T>(o / olen));
-  return pc > T(0) ? pc * v.det_inv / (olen * olen * olen) : T(0);
+  if (!(olen > T(0)) || !(o.z() > T(0))) return T(0);  // (M^-1 w)_z > 0: the LTC's support, z >= 0 of M^-1 P
+  const Vec3<T> c = o / olen;
+  const T mlen = (v.m * c).norm();
+  const T pc = c.z() / v.transformed.projected_solid_angle;
+  const T p = pc * (mlen * mlen * mlen) * v.det_inv;
+  return p > T(0) && std::isfinite(p) ? p : T(0);
 }
 
 // Tangent-line iterations of the decentral sector inversion (Peters 2021 Sec. 3.3; the paper's default is 2).

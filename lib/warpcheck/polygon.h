@@ -239,6 +239,19 @@ template <class T> PolygonView<T> make_polygon_view(const PolygonLightGeometry<T
   return v;
 }
 
+// The planes through x and the light's own edges, (V_j - x) x (V_{j+1} - V_j), oriented inwards (by the side of
+// the light x is on): a direction w is in the light's cone iff every plane's dot product with w is >= 0. From the
+// world coordinates, not from rounded directions V - x: V_{j+1} - V_j of nearby vertices is exact (Sterbenz), so
+// a short edge keeps its direction (polygon_projected.h, ltc.h). Returns the number of planes, g.light.count.
+template <class T> int polygon_inward_planes(const PolygonLightGeometry<T>& g, const PolygonView<T>& pv, Vec3<T>* out) {
+  const int n = g.light.count;
+  const T orient = pv.plane_distance < T(0) ? T(-1) : T(1);
+  for (int j = 0; j < n; ++j)
+    out[j] = orient * kahan_cross(Vec3<T>(g.light.vertices[j] - g.shading.position),
+                                  Vec3<T>(g.light.vertices[(j + 1) % n] - g.light.vertices[j]));
+  return n;
+}
+
 // ---- Bounding caps ---------------------------------------------------------------------------------------
 
 // A small cap containing the convex spherical polygon spanned by the given directions (a cap of half-angle

@@ -143,14 +143,26 @@ template <class T> struct ProjectedSector {
   T area = 0;
 };
 
-// The homogeneous quadratic w^T T w = 0 solved for the root of Eq. 6 (Blinn 2006 as specialised by Peters):
-// both branches give the projective root x / y = (-b - sqrt(Delta)) / a with a = T_xx, 2b = T_xy + T_yx,
-// c = T_yy, Delta = b^2 - a c (= -|T + T^T| / 4). Delta by Kahan's determinant: it cancels near double roots.
-template <class T> Vec2<T> solve_homogeneous_quadratic(const Eigen::Matrix<T, 2, 2>& Tm) {
-  const T b = (Tm(0, 1) + Tm(1, 0)) / T(2);
-  const T delta = std::max(T(0), kahan_det(b, Tm(0, 0), Tm(1, 1), b));
-  const T root = std::abs(b) + std::sqrt(delta);
-  return b >= T(0) ? Vec2<T>(root, -Tm(0, 0)) : Vec2<T>(Tm(1, 1), root);
+// The root of Eq. 6, w^T T w = 0, found around a nearby direction `base` (the current iterate, or the quad's
+// start boundary s_k). Blinn 2006 as specialised by Peters (Supplement A.3, not available to us) takes the
+// projective root x / y = (-b - sqrt(Delta)) / a of the symmetric part S of T (a = T_xx, 2b = T_xy + T_yx,
+// c = T_yy, Delta = b^2 - a c); that is the null direction r of S with r x (S r) > 0 (our derivation). We write
+// w = base + tau R base (R: rotation by +90 degrees), so w^T T w = P(tau) = a0 + a1 tau + a2 tau^2, and the
+// rule, being invariant under rotations and scalings, becomes r x (S r) = P'(tau) (1 + tau^2) / 2 > 0: the
+// root where P increases, tau = (-a1 + sqrt(D)) / (2 a2) = -2 a0 / (a1 + sqrt(D)), D = a1^2 - 4 a0 a2, each
+// form used where it does not cancel. The callers build a0, a1, a2 from T's factors, so a0 (the residual term)
+// carries no rounding from the terms that vanish exactly at tau = 0.
+// Why not Blinn's formula on T's entries (our remedy, issue 4): those entries are O(|C w|^2), and where the
+// inner and outer ellipses nearly coincide (a small light far away: a sector 2e-4 rad wide, the ellipses 2.5e-4
+// apart relative) the root moves by their rounding, eps / 2.5e-4 rad, which in float exceeded the sector: the
+// 1 cm light 40 m away (far-1cm) sampled up to 0.43 light widths off the exact inverse, and did not improve with
+// more iterations (chi2 p = 0 at 1e7 samples). Around base, the step tau has rounding relative to itself.
+// Returns w up to sign (the callers orient it with the sector's half-vector); 0 when all coefficients vanish.
+template <class T> Vec2<T> increasing_root_around(const Vec2<T>& base, T a0, T a1, T a2) {
+  const T sq = std::sqrt(std::max(T(0), kahan_det(a1, T(4) * a0, a2, a1)));
+  const bool up = a1 >= T(0);
+  const T num = up ? -T(2) * a0 : sq - a1, den = up ? a1 + sq : T(2) * a2;  // tau = num / den
+  return den * base + num * Vec2<T>(-base.y(), base.x());
 }
 
 // Approximate L1 normalisation (Sec. 3.7): guards against under- and overflow; the length is irrelevant.
@@ -166,9 +178,23 @@ template <class T, bool kBiased = false> T decentral_area_to(const ProjectedSect
          ellipse_sector_area<T, kBiased>(s.inner, s.s0, w, cross);
 }
 
-// Eq. 7: residual A_delta(w) = A - area(s0 -> w).
+// The area between the ellipses in the sector from w to s1.
+template <class T, bool kBiased = false> T decentral_area_from(const ProjectedSector<T>& s, const Vec2<T>& w) {
+  const T cross = kahan_cross2(w, s.s1);
+  return ellipse_sector_area<T, kBiased>(s.outer, w, s.s1, cross) -
+         ellipse_sector_area<T, kBiased>(s.inner, w, s.s1, cross);
+}
+
+// Eq. 7: residual A_delta(w) = A - area(s0 -> w), measured from the sector's nearer end: for A beyond half the
+// sector's area as area(w -> s1) - (A_j - A), equal in exact arithmetic. Why (our remedy, issue 4): the area is a
+// difference of two ellipse areas, each up to ~1e3 times larger than it for a small far light, so its rounding
+// is eps times the larger terms. Where the chains meet at s1 (the tip of the last sector), the area left to the
+// tip is tiny and the difference from s0 cannot resolve it: float samples of the 1 cm light 40 m away with A
+// within 5e-4 of A_j were up to 1.7e-2 light widths off and piled up in the corner (chi2 bin +18 sigma at 1e7).
+// From s1, both terms shrink with the area they bound.
 template <class T, bool kBiased = false> T decentral_residual(const ProjectedSector<T>& s, T target, const Vec2<T>& w) {
-  return target - decentral_area_to<T, kBiased>(s, w);
+  if (target <= s.area / T(2)) return target - decentral_area_to<T, kBiased>(s, w);
+  return decentral_area_from<T, kBiased>(s, w) - (s.area - target);
 }
 
 // Section 3.4: the two-quad initialisation. The quad vertices are lambda_{l,j} s_j (l in {i, o}, j in {k, h});
@@ -210,10 +236,15 @@ Vec2<T> decentral_initialization(const ProjectedSector<T>& s, T target) {
   const Vec2<T> ri = s.inner.times(Vec2<T>(mu(s.inner, sh) * sh + mu(s.inner, sk) * sk));
   const Vec2<T> ro = s.outer.times(Vec2<T>(mu(s.outer, sh) * sh + mu(s.outer, sk) * sk));
   const T di = lih * ri.dot(sh), do_ = loh * ro.dot(sh);
+  // w^T Q w with w = s_k + tau R s_k (increasing_root_around): w . R s_k = tau |s_k|^2, r_l . w = r_l . s_k +
+  // tau r_l . R s_k, so P(tau) = lambda_{o,k} D_o tau |s_k|^2 (r_i . w) - (lambda_{i,k} D_i tau |s_k|^2 + 2 A_q r_i . w)
+  // (r_o . w).
   const Vec2<T> rsk(-sk.y(), sk.x());  // R s_k
-  const Eigen::Matrix<T, 2, 2> Q =
-      (lok * do_) * rsk * ri.transpose() - (Vec2<T>(lik * di * rsk + T(2) * aq * ri)) * ro.transpose();
-  Vec2<T> w = solve_homogeneous_quadratic<T>(Q);
+  const T ri_s = ri.dot(sk), ri_p = ri.dot(rsk), ro_s = ro.dot(sk), ro_p = ro.dot(rsk), s2 = sk.squaredNorm();
+  const T a0 = -T(2) * aq * ri_s * ro_s;
+  const T a1 = s2 * (lok * do_ * ri_s - lik * di * ro_s) - T(2) * aq * (ri_s * ro_p + ri_p * ro_s);
+  const T a2 = s2 * (lok * do_ * ri_p - lik * di * ro_p) - T(2) * aq * ri_p * ro_p;
+  Vec2<T> w = increasing_root_around(sk, a0, a1, a2);
   if (w.dot(sh) < T(0)) w = -w;
   if (!(std::abs(w.x()) + std::abs(w.y()) > T(0)) || !all_finite(Vec3<T>(w.x(), w.y(), T(0)))) w = sh;
   return l1_normalized(w);
@@ -223,11 +254,22 @@ Vec2<T> decentral_initialization(const ProjectedSector<T>& s, T target) {
 template <class T, bool kBiased = false>
 Vec2<T> decentral_iteration(const ProjectedSector<T>& s, T target, const Vec2<T>& wn) {
   const T a_delta = decentral_residual<T, kBiased>(s, target, wn);
-  const Vec2<T> ci_w = s.inner.times(wn), co_w = s.outer.times(wn);
+  // T = R w_n x^T - 2 A_delta (C_i w_n)(C_o w_n)^T with x = c_o C_i w_n - c_i C_o w_n (homogeneous C = Ct / n_z^2,
+  // c = n_z^2). With w = w_n + tau R w_n (increasing_root_around) and f = w_n^T Ct w_n, g = (R w_n)^T Ct w_n
+  // = (n_xy . w_n)(n_xy . R w_n) (the n_z^2 w_n . R w_n term is 0), P(tau) = tau |w_n|^2 (x . w_n + tau x . R w_n)
+  // - 2 A_delta (f_i + tau g_i)(f_o + tau g_o). x . w_n = c_o f_i - c_i f_o = (n_{o,z} d_i)^2 - (n_{i,z} d_o)^2 with
+  // d = n_xy . w_n, since the |w_n|^2 terms cancel exactly: it is taken as a difference of squares.
   const Vec2<T> rw(-wn.y(), wn.x());  // R w_n
-  const Eigen::Matrix<T, 2, 2> Tm =
-      rw * Vec2<T>(s.outer.c() * ci_w - s.inner.c() * co_w).transpose() - (T(2) * a_delta) * ci_w * co_w.transpose();
-  Vec2<T> w = solve_homogeneous_quadratic<T>(Tm);
+  const T n2 = wn.squaredNorm();
+  const T di = s.inner.nxy.dot(wn), d_o = s.outer.nxy.dot(wn);
+  const T fi = s.inner.c() * n2 + di * di, fo = s.outer.c() * n2 + d_o * d_o;
+  const T gi = di * s.inner.nxy.dot(rw), go = d_o * s.outer.nxy.dot(rw);
+  const T p = s.outer.nz * di, q = s.inner.nz * d_o;
+  const T x_w = (p - q) * (p + q), x_rw = s.outer.c() * gi - s.inner.c() * go;
+  const T a0 = -T(2) * a_delta * fi * fo;
+  const T a1 = n2 * x_w - T(2) * a_delta * (fi * go + gi * fo);
+  const T a2 = n2 * x_rw - T(2) * a_delta * gi * go;
+  Vec2<T> w = increasing_root_around(wn, a0, a1, a2);
   // "The sign on the resulting direction may be wrong, so we check the dot product with the half-vector."
   const Vec2<T> sh = s.s0 / s.s0.norm() + s.s1 / s.s1.norm();
   if (w.dot(sh) < T(0)) w = -w;
@@ -300,6 +342,24 @@ template <class T> struct PolygonProjectedView {
   }
 };
 
+// Whether the clipped polygon's xy projection winds around the zenith (the origin): the azimuth increments
+// atan2(a x b, a . b) of its edges add up to 2 pi around it and to 0 outside. Central (Sec. 3.1) is "no edge has
+// n_z < 0", but an edge whose n_z is within the rounding of its endpoints' coordinates has a sign of rounding
+// noise: a doubled vertex, or a short edge far from the zenith whose line the coordinates do not place to the
+// zenith's side of it. One such sign made polygons around the zenith decentral, where the chains of Fig. 3b do
+// not exist (found by fuzz_ltc_double with M = I: octagons around the zenith with a doubled vertex, and one seen
+// from 5e-9 beside a vertex with a short edge at n_z = -5e-16 whose direction is known to 2e-6 rad, A_Sigma ~1e-33
+// instead of 0.11..1.6, issue 7). Such an edge adds an increment of the order of its own noise to the sum, so the
+// winding number decides unless the zenith is within rounding of the boundary, where either case is right.
+template <class T> bool winds_around_zenith(const LocalPolygon<T>& p) {
+  T sum = 0;
+  for (int j = 0; j < p.count; ++j) {
+    const Vec2<T> a(p.v[j].x(), p.v[j].y()), b(p.v[(j + 1) % p.count].x(), p.v[(j + 1) % p.count].y());
+    sum += std::atan2(kahan_cross2(a, b), a.dot(b));
+  }
+  return sum > kPi<T>;
+}
+
 template <class T, bool kBiased = false> PolygonProjectedView<T> make_polygon_projected_view(const PolygonLightGeometry<T>& g) {
   PolygonProjectedView<T> v;
   const PolygonView<T> pv = make_polygon_view(g);
@@ -307,11 +367,7 @@ template <class T, bool kBiased = false> PolygonProjectedView<T> make_polygon_pr
   v.frame = pv.frame;
   v.flip_y = pv.plane_distance < T(0);
   {
-    const int n = g.light.count;
-    const T orient = v.flip_y ? T(-1) : T(1);
-    for (int j = 0; j < n; ++j)
-      v.inward[j] = orient * kahan_cross(Vec3<T>(g.light.vertices[j] - g.shading.position),
-                                         Vec3<T>(g.light.vertices[(j + 1) % n] - g.light.vertices[j]));
+    const int n = polygon_inward_planes(g, pv, v.inward.data());
     v.inward[n] = pv.normal;
     v.planes = n + 1;
   }
@@ -337,7 +393,7 @@ template <class T, bool kBiased = false> PolygonProjectedView<T> make_polygon_pr
   }
   if (!any_positive) return v.reason = NoSample::kTooSmall, v;  // no projected area representable
   auto xy = [&](int i) { return Vec2<T>(v.clipped.v[(i % m + m) % m].x(), v.clipped.v[(i % m + m) % m].y()); };
-  v.central = !any_negative;
+  v.central = !any_negative || winds_around_zenith(v.clipped);
   if (v.central) {
     // Sec. 3.1, Fig. 3a: one sector per edge. Its sine s0 x s1 is n_{j,z} >= 0 by construction.
     for (int j = 0; j < m; ++j) {
@@ -347,19 +403,32 @@ template <class T, bool kBiased = false> PolygonProjectedView<T> make_polygon_pr
       s.area = std::max(T(0), ellipse_sector_area<T, kBiased>(s.outer, s.s0, s.s1, v.edge_normals[j].z()));
     }
   } else {
-    // Fig. 3b: find the clockwise end c (first edge of the outer chain), then merge the chains.
-    int c = -1;
-    for (int j = 0; j < m && c < 0; ++j)
-      if (sign[j] > 0 && sign[(j + m - 1) % m] <= 0) c = j;
-    if (c < 0) return v.reason = NoSample::kTooSmall, v;
+    // Fig. 3b: find the clockwise end c and the counterclockwise end e of the outer chain, then merge the chains:
+    // the outer chain runs forward from c to e, the inner one backward from c to e. The ends are where the signs
+    // change between the runs of outer (+) and inner (-) edges, skipping edges of sign 0 (radial, or of length 0 in
+    // xy): such an edge can lie inside a run (a doubled vertex, three collinear vertices on a ray), and
+    // stopping a chain there lost the rest of the light (found by fuzz_ltc_double with M = I, c37ad58b: a
+    // triangle with a doubled vertex cut by the horizon, A_Sigma 9.3e-22 instead of 1.57e-4, issue 7). Where
+    // rounding still leaves more than one run of each sign (edges within rounding of a ray that point the wrong
+    // way), the true ends are the most clockwise run start and the most counterclockwise run end; the edges
+    // between them are assigned to the chains by position, and a sector of negative width gets area 0 below.
+    auto nonzero_sign = [&](int j, int step) {
+      for (int k = 1; k < m; ++k)
+        if (const int sg = sign[((j + step * k) % m + m) % m]; sg != 0) return sg;
+      return 0;
+    };
+    int c = -1, e = -1;
+    for (int j = 0; j < m; ++j) {
+      if (sign[j] <= 0) continue;
+      if (nonzero_sign(j, -1) < 0 && (c < 0 || kahan_cross2(xy(c), xy(j)) < T(0))) c = j;
+      if (nonzero_sign(j, 1) < 0 && (e < 0 || kahan_cross2(xy(e), xy(j + 1)) > T(0))) e = (j + 1) % m;
+    }
+    if (c < 0 || e < 0 || c == e) return v.reason = NoSample::kTooSmall, v;
     std::array<int, kMaxClippedVertices + 1> ov{}, oe{}, iv{}, ie{};
-    int no = 0, ni = 0;
-    ov[0] = c;
-    for (int j = c, k = 0; sign[j % m] > 0 && k < m; ++j, ++k) oe[no] = j % m, ov[++no] = (j + 1) % m;
-    int b = c;
-    for (int k = 0; sign[(b + m - 1) % m] == 0 && k < m; ++k) b = (b + m - 1) % m;  // a radial edge at the end
-    iv[0] = b;
-    for (int j = (b + m - 1) % m, k = 0; sign[j] < 0 && k < m; j = (j + m - 1) % m, ++k) ie[ni] = j, iv[++ni] = j;
+    const int no = (e - c + m) % m, ni = m - no;
+    ov[0] = c, iv[0] = c;
+    for (int k = 0; k < no; ++k) oe[k] = (c + k) % m, ov[k + 1] = (c + k + 1) % m;
+    for (int k = 0; k < ni; ++k) ie[k] = (c - k - 1 + m) % m, iv[k + 1] = ie[k];
     int a = 0, bi = 0;
     Vec2<T> cur = xy(ov[0]);
     while (a < no && bi < ni && v.sector_count < kMaxClippedVertices) {

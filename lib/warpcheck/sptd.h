@@ -4,6 +4,7 @@
 // Contents (equation numbers are the paper's):
 //   pivot_transform_point   Eq. 2, the pivot transformation of any point of R^3 (an involution, Eq. 3)
 //   pivot_transform         Eq. 2 restricted to the unit sphere, in the form g(w) = r_p + k (r_p - w) / |r_p - w|^2
+//                           (r_p - w by pivot_offset, for the unit vector in w's direction)
 //   pivot_jacobian          Eq. 4, d g(w) / d w = (k / |w - r_p|^2)^2, k = 1 - |r_p|^2
 //   pivot_transform_cap     Eqs. 6-7, the image g(C) of a spherical cap
 //   sptd_density            Eq. 8, D(w) = D_std(g(w)) dg/dw for the uniform and the clamped-cosine D_std
@@ -19,6 +20,8 @@
 //    intersection of the line from w through r_p with the sphere: |g(w) - r_p| |w - r_p| = k is Eq. 33, and
 //    g(w) - r_p points away from w - r_p). test_sptd checks the two forms agree. We use the second form on
 //    the sphere: it has no cancellation in its denominator, and it is exactly what the Jacobian (Eq. 4) refers to.
+//    It holds for unit w only; w - r_p is taken for the unit vector in w's direction (pivot_offset), as a rounded
+//    "unit" vector's length error is amplified by k / |w - r_p|^2 there.
 //  * Eq. 6 takes the normalised mean of the two transformed boundary points as the axis of g(C). That is
 //    right only when g(C) is at most a hemisphere; for a larger image cap the mean points to the centre of the
 //    complement, and for a hemisphere it is zero. We take the axis as +-the in-plane bisector of g(w_1),
@@ -74,11 +77,31 @@ template <class T> Vec3<T> pivot_transform_point(const Vec3<T>& r, const Vec3<T>
   return (a * d - d.cross(c)) / (a * a + c.squaredNorm());
 }
 
-// Eq. 2 on the unit sphere, in the anti-inversion form derived in the header comment; renormalised.
+// r_p - w for the unit vector in w's direction (w != 0), from quantities exact for it: with p = r_p / |r_p| and
+// theta = angle(w, p), r_p - w = ((1 - cos theta) - (1 - |r_p|)) p - (w's part orthogonal to p), 1 - cos theta as
+// sin^2 / (1 + cos) near p. The plain difference r_p - w carries w's length error (1 +- eps for any rounded unit
+// vector), which the anti-inversion divides by |r_p - w|^2 ~ (1 - |r_p|)^2 near p: for |r_p| = 1 - eps/2 and w on p
+// with |w| = 1 + eps it gave g = 0 (UBSan division by zero in the normalisation, found by fuzz_sptd_double, issue 7).
+// Here the component along p is -(1 - |r_p|) to rounding for w near p, with the same 1 - |r_p| as pivot_k, so
+// |r_p - w|^2 >= (1 - |r_p|)^2 > 0. A pivot shorter than eps / 8 moves g(w) from -w by at most 2 |r_p| < eps / 4
+// (Eq. 2): taken as 0.
+template <class T> Vec3<T> pivot_offset(const Vec3<T>& w, const Vec3<T>& rp) {
+  const T wn = w.norm();
+  const T r = rp.norm();  // as in pivot_k
+  if (!(r > std::numeric_limits<T>::epsilon() / T(8))) return -w / wn;
+  const Vec3<T> p = rp / r;
+  const Vec3<T> x = w.cross(p) / wn;  // |x| = sin theta; w's part orthogonal to p is |w| p x x
+  const T c = w.dot(p) / wn;
+  const T one_minus_c = c > T(0) ? x.squaredNorm() / (T(1) + c) : T(1) - c;
+  return (one_minus_c - (T(1) - r)) * p - p.cross(x);
+}
+
+// Eq. 2 on the unit sphere, in the anti-inversion form derived in the header comment, for the unit vector in w's
+// direction (pivot_offset); renormalised.
 template <class T> Vec3<T> pivot_transform(const Vec3<T>& w, const Vec3<T>& rp, T k) {
-  const Vec3<T> d = rp - w;
+  const Vec3<T> d = pivot_offset(w, rp);
   const T d2 = d.squaredNorm();
-  if (!(d2 > T(0))) return w;  // w on the pivot: impossible for |r_p| < 1 and unit w
+  if (!(d2 > T(0))) return -w / w.norm();  // only where |r_p| rounds to 1 (k = 0, no pivot): g(p) = -p
   const Vec3<T> g = rp + (k / d2) * d;
   return g / g.norm();
 }
@@ -88,7 +111,7 @@ template <class T> Vec3<T> pivot_transform(const Vec3<T>& w, const Vec3<T>& rp) 
 
 // Eq. 4: the Jacobian dg(w)/dw = (k / |w - r_p|^2)^2 of the transformation on the sphere.
 template <class T> T pivot_jacobian(const Vec3<T>& w, const Vec3<T>& rp, T k) {
-  const T j = k / (w - rp).squaredNorm();
+  const T j = k / pivot_offset(w, rp).squaredNorm();
   return j * j;
 }
 template <class T> T pivot_jacobian(const Vec3<T>& w, const Vec3<T>& rp) { return pivot_jacobian(w, rp, pivot_k(rp)); }
@@ -135,7 +158,8 @@ template <class T> Cap<T> pivot_transform_cap(const Cap<T>& c, const Vec3<T>& rp
   // of the cap around the bisector (diameter >= pi): no flip there.
   const T rn = rp.norm();
   const bool contains_pivot = rn > T(0) && (rp / rn - wc).squaredNorm() <= T(2) * omc;
-  const T d_min = contains_pivot ? T(1) - rn : std::min((p1 - rp).norm(), (p2 - rp).norm());
+  const T d1 = pivot_offset(p1, rp).norm(), d2 = pivot_offset(p2, rp).norm();  // |p_i - r_p| for unit p_i
+  const T d_min = contains_pivot ? T(1) - rn : std::min(d1, d2);
   const T alpha = T(2) * std::asin(std::min(T(1), std::sqrt(omc / T(2))));
   const bool surely_small = T(2) * alpha * k < kPi<T> / T(2) * d_min * d_min;
   if (!surely_small && (gc - axis).squaredNorm() > (g1 - axis).squaredNorm()) axis = -axis;
@@ -147,9 +171,10 @@ template <class T> Cap<T> pivot_transform_cap(const Cap<T>& c, const Vec3<T>& rp
   // k |p - q| / (|p - r_p| |q - r_p|), and g1, g2 are the ends of a diameter of the image circle (which is
   // symmetric about the plane); hence sin(psi'') = k sin(alpha) / (|p1 - r_p| |p2 - r_p|) for the smaller of the
   // two caps the circle bounds, and 1 - cos(psi'') = s^2 / (1 + sqrt(1 - s^2)) without cancellation.
-  // (A boundary point can coincide with r_p in T when |r_p| is within an ulp of 1: then the formula is not used;
-  // found by fuzz_sptd_double under UBSan's float-divide-by-zero, issue 7.)
-  const T chord_denominator = (p1 - rp).norm() * (p2 - rp).norm();
+  // (The plain differences p_i - r_p vanished for a boundary point on r_p's direction when |r_p| is within an ulp
+  // of 1, found by fuzz_sptd_double under UBSan's float-divide-by-zero, issue 7; pivot_offset's distances are at
+  // least 1 - |r_p| > 0, the guard stays for k = 0.)
+  const T chord_denominator = d1 * d2;
   const T s = chord_denominator > T(0) ? k * sin_a / chord_denominator : T(1);
   T image_omc;
   if (s < T(0.5)) {

@@ -1,6 +1,8 @@
 // Polygon-light kernels (Peters 2021 and the published baselines) and their named configurations.
+#include <algorithm>
 #include <cmath>
 #include <functional>
+#include <utility>
 #include <vector>
 
 #include "warpcheck/polygon_projected.h"
@@ -22,6 +24,31 @@ template <class T> Cap<T> cap_of_polygon(const PolygonLightGeometry<T>& g) {
   std::array<Vec3<T>, kMaxPolygonVertices> w;
   for (int i = 0; i < g.light.count; ++i) w[i] = g.light.vertices[i] - g.shading.position;
   return bounding_cap_of_directions(w.data(), g.light.count);
+}
+
+// Unit normals of the planes through x and each edge (degenerate edges skipped).
+std::vector<Vec3L> edge_planes(const PolygonLightGeometry<Real>& g) {
+  std::vector<Vec3L> planes;
+  const int n = g.light.count;
+  for (int i = 0; i < n; ++i) {
+    const Vec3L e = (g.light.vertices[i] - g.shading.position).cross(g.light.vertices[(i + 1) % n] - g.shading.position);
+    if (e.norm() > 0) planes.push_back(e.normalized());
+  }
+  return planes;
+}
+
+// The angular width of the polygon seen from x: for a convex spherical polygon, the smallest over its edges of
+// the largest angular distance of a vertex from the edge's great circle (a polygon seen 0.3 deg from its plane:
+// 2.7e-3 rad, in a bounding cap of 0.32 rad).
+Real angular_width(const PolygonLightGeometry<Real>& g, const std::vector<Vec3L>& edges) {
+  Real width = kPi<Real>;
+  for (const Vec3L& m : edges) {
+    Real far = 0;
+    for (int j = 0; j < g.light.count; ++j)
+      far = std::max(far, std::asin(std::min<Real>(1, std::abs(m.dot((g.light.vertices[j] - g.shading.position).normalized())))));
+    width = std::min(width, far);
+  }
+  return width;
 }
 
 // Kinks of a warp that picks a piece (fan triangle, sector) by xi_0 in proportion to `area`: the warp is
@@ -220,10 +247,31 @@ std::vector<PolygonConfig> configs() {
 //    At 1e7 samples the battery sees it, which is the point of listing it: measured in double chi2 p = 0 on
 //    straddling-horizon, pdf-consistency up to 6.8e-2 (decentral-square), normalisation 2.8e-6 (central-square)
 //    to 1.3e-4 (far-1cm).
+//  * Urena et al. 2013 as published on the 1 mm light (double): pdf-consistency with 1526 of 2048 points
+//    unresolved (the warp's finite differences at steps h and 2h disagree), 7.3e-7 where resolved.
 //  * Arvo 1995 as published on tiny distant lights (Peters 2021 Sec. 5 and Fig. 7: its solid-angle inversion
 //    cancels): measured in double pdf-consistency 6.7e-4 (far-1cm) and 1 (far-1mm: samples outside the light).
+//  * float on the 1 mm light 40 m away (Fig. 7b), every kernel: float's unit vectors near its direction are 6e-8
+//    rad apart, 1/426 of the light's 2.5e-5 rad width (1/4262 at 1 cm), so sampled directions lie on a lattice
+//    the battery's bins resolve at 1e7 samples, and some round to just outside the light. Measured on Turk (float
+//    arithmetic only where it samples a point and normalises; test
+//    PolygonFloat.DirectionsToTheOneMillimetreLightLieOnALattice, 1e6 samples): 343292 distinct directions,
+//    541 samples with pdf(direction) = 0; at 1 cm 984300 distinct and 49. Battery (float,
+//    1e7): chi2 and KS p < 1e-45 for every kernel, pdf-consistency 1 (a sample's direction outside the light).
+//    Peters 2021 Sec. 3.7 recommends area sampling here; in float that is no cure either.
+//  * Arvo 1995 and Urena et al. 2013 in float on both far lights: their solid angles (angle sums minus pi resp.
+//    2 pi) cancel: 1 cm, 0 (Arvo: no samples) and -2.4e-7 (Urena) for 5.3e-8 sr; 1 mm, 0 and 2.4e-7 for 5.3e-10.
 const char* polygon_known_limitation(const std::string& kernel, const std::string& scalar, const std::string& config) {
   if (config == "below-horizon") return "";
+  if (scalar == "float" && (config == "far-1cm" || config == "far-1mm") && (kernel == "baseline-arvo-triangle" || kernel == "baseline-urena-rectangle"))
+    return "as published, the baseline's solid angle (a sum of angles minus pi or 2 pi) cancels in float on the 1 cm "
+           "and 1 mm lights 40 m away (1 cm: Arvo 0, i.e. no samples, Urena -2.4e-7 for 5.3e-8 sr; 1 mm: Arvo 0, Urena 2.4e-7 "
+           "for 5.3e-10); a baseline, not fixed";
+  if (scalar == "float" && config == "far-1mm" && kernel != "polygon-projected-solid-angle-biased")
+    return "float cannot resolve a 1 mm light 40 m away (Peters 2021 Fig. 7b): its unit vectors there are 6e-8 rad "
+           "apart, 1/426 of the light's width, so samples lie on a lattice the bins resolve at 1e7 samples (chi2, KS) "
+           "and some round to just outside the light (pdf 0: pdf-consistency 1); measured on Turk: 343292 distinct "
+           "directions and 541 outside in 1e6 samples; see registry_polygon.cpp";
   if (kernel == "polygon-projected-solid-angle-biased")
     return "biased by design (Peters 2021 Sec. 6.4: no iteration, arctangent approximated to 1.2e-5 rad); the "
            "battery is expected to see the bias at 1e7 samples (double: chi2 p = 0 straddling-horizon, "
@@ -231,6 +279,11 @@ const char* polygon_known_limitation(const std::string& kernel, const std::strin
   if (kernel == "baseline-arvo-triangle" && scalar != "long double" && (config == "far-1cm" || config == "far-1mm"))
     return "Arvo 1995 as published cancels on tiny distant triangles (Peters 2021 Sec. 5, Fig. 7): double "
            "pdf-consistency 6.7e-4 (1 cm at 40 m) and 1 (1 mm: samples outside the light); a baseline, not fixed";
+  if (kernel == "baseline-urena-rectangle" && scalar != "long double" && config == "far-1mm")
+    return "Urena et al. 2013 as published on a 1 mm light 40 m away: the finite-difference Jacobian check cannot "
+           "resolve its warp (the same baseline in long double; likely cause, not analysed: its solid angle is a sum "
+           "of four angles minus 2 pi, which cancels): double pdf-consistency 1526 of 2048 points unresolved (5% "
+           "allowed), 7.3e-7 where resolved; a baseline, not fixed";
   return "";
 }
 
@@ -247,6 +300,19 @@ void add_case(Registry& r, const char* kernel, const PolygonConfig& c, Measure m
     s.pdf = K<T>::cached_pdf(c.g.template cast<T>());  // same density as K::pdf, without rebuilding the view
     s.expect_no_sample = !K<Real>::sample(c.g, Vec2<Real>(0.5L, 0.5L)).valid();
     s.kinks_u0 = K<Real>::kinks_u0(c.g);
+    // Breakpoints only for slivers (thinner than a sixteenth of the bounding cap's radius, the default grid's
+    // ring spacing): they multiply the quadrature's cost (measured on central-square, projected kernel: double,
+    // 1000 samples, 19.9 s -> 78.6 s of CPU; float at 1e7 samples 14 min of CPU with them, no comparison run; the
+    // float pdf's jumps lie off the long double planes, likely the cause), and the default nodes already resolve
+    // every other configuration (the double battery of 9ec2b69 passed them all).
+    const Real theta_max = std::acos(std::clamp<Real>(1 - s.bounding_cap.one_minus_cos, -1, 1));
+    // The great circles on which the pdfs jump or kink: the edges' planes and the horizon (where the clipped
+    // kernels' supports end and the projected density's cosine reaches 0).
+    std::vector<Vec3L> planes = edge_planes(c.g);
+    if (angular_width(c.g, planes) < theta_max / 16) {
+      if (c.g.shading.normal.norm() > 0) planes.push_back(c.g.shading.normal.normalized());
+      s.boundary_planes = std::move(planes);
+    }
     if (s.expect_no_sample || measure == Measure::kNone) return s;
     Normalization n;
     n.kernel = [g = c.g.template cast<T>()] { return Real(K<T>::normaliser(g)); };

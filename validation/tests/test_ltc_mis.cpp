@@ -73,6 +73,52 @@ TEST(Ltc, SingularOrReflectingTransformsGiveNoSample) {
   EXPECT_EQ(sample_ltc_polygon(LtcPolygonGeometry<double>{pg, s}, Vec2<double>(0.5, 0.5)).reason, NoSample::kInvalidGeometry);
 }
 
+// pdf() at the sampler's own direction gives the sampler's pdf, to the rounding of the density formula (16 eps, the
+// fuzz target's allowance), for a near-singular M (sigma_1 / sigma_3 = 1024): Eigen's inverse is off by |E| =
+// |M Minv - I| = 8.9e-14, and 1 / |Minv w|^3 made the density 3 (E w).w = -8.3e-14 off (fuzz_ltc_double b98e6f95,
+// issue 7).
+TEST(Ltc, PdfEqualsTheSamplePdfForANearSingularTransform) {
+  LtcPolygonGeometry<double> g;
+  g.polygon = PolygonLightGeometry<double>{
+      ShadingPoint<double>{{-0.99999999999999989, -6, 1.4786832970547863e-06},
+                           {0.86266443124090197, 0.43133202034078566, 0.26412642295034983}},
+      PolygonLight<double>{{-1, -6, 0}, {-6.4282032302755097, -9, 0}, {7.428203230275507, -9, 0}}};
+  g.m << 0.15393094311796404, 0.22611176580258044, 0.85231093149425219, 0.17081421027716473, 0.25144152677360854,
+      -0.51632961880767692, -0.51506759306050398, -0.75331582125345931, 0.083485332827504477;
+  const auto v = make_ltc_polygon_view(g);
+  ASSERT_TRUE(v.valid());
+  const auto s = sample_ltc_polygon(v, Vec2<double>(0, 0));
+  ASSERT_TRUE(s.valid());
+  EXPECT_NEAR(pdf_ltc_polygon(v, s.direction) / s.pdf, 1, 16 * std::numeric_limits<double>::epsilon());
+}
+
+// pdf() is positive at samples well inside the light when two vertices 3e51 apart (at 2e67) lie on the horizon
+// up to rounding: the edge planes of the transformed polygon M^-1 P came from rounded vertices, and that edge's
+// became the horizon with a random orientation, pdf 0 at samples 0.09 rad inside (fuzz_ltc_double 834135fe,
+// issue 7).
+TEST(Ltc, PdfIsPositiveAtSamplesInsideALightWithAShortEdgeOnTheHorizon) {
+  LtcPolygonGeometry<double> g;
+  g.polygon = PolygonLightGeometry<double>{
+      ShadingPoint<double>{{-4.871296688397204e+67, 1.1610359843866627e+67, -2.435648344198602e+67},
+                           {0.59148163293412626, -0.12975569400939727, -0.7958096115112705}},
+      PolygonLight<double>{{-2.2716570681338925e+67, -1.8921621456179815e+67, -5.6589321981982735e+64},
+                           {-2.3301947293937325e+67, -9.4215158378992969e+66, 7.5404429194839272e+66},
+                           {4.6955021667812761e+66, 1.6641069401263595e+67, 1.5688122326536821e+67},
+                           {1.3549784773173498e+67, 1.8592051854531317e+67, 1.339998953880259e+67},
+                           {1.9288329403068742e+66, -3.4493062043374888e+66, 1.3394595283227462e+66},
+                           {-2.2716570681338922e+67, -1.8921621456179815e+67, -5.6589321981983858e+64}}};
+  g.m = Mat3<double>::Identity();
+  g.m(1, 0) = 7.1054273576010019e-15;
+  const auto v = make_ltc_polygon_view(g);
+  ASSERT_TRUE(v.valid());
+  for (const double u0 : {0.125, 0.32118955207696653, 0.5, 0.50526390524856635, 0.75, 0.875})
+    for (const double u1 : {0.25, 0.5, 0.99999618530273438}) {
+      const auto s = sample_ltc_polygon(v, Vec2<double>(u0, u1));
+      ASSERT_TRUE(s.valid());
+      EXPECT_NEAR(pdf_ltc_polygon(v, s.direction) / s.pdf, 1, 1e-6) << u0 << " " << u1;
+    }
+}
+
 // ---- MIS ------------------------------------------------------------------------------------------------------
 
 MixedPolygonShading<double> mixed(const M3& m1, double a0, double a1) {

@@ -102,6 +102,49 @@ TEST(SptdPivot, SphereFormAgreesWithEq2AndBothAreInvolutions) {
   EXPECT_LT(worst_point_inv, 1e-13L);
 }
 
+// A pivot within an ulp of the sphere, r = 1 - eps/2, and w on its direction p: g(w) = -p and Eq. 4 gives
+// ((1 + r) / (1 - r))^2, whatever w's length (1 +- a few eps, as any rounded unit vector). The plain difference
+// r_p - w is of the order of that length error there: the kernel gave g = +p, Jacobian Inf for |w| = r, and for
+// the vectors of fuzz_sptd_double 262911f1 g = 0 (0 / 0, UBSan float-divide-by-zero), issue 7.
+template <class T> void expect_on_pivot_direction_maps_to_antipode() {
+  const T eps = std::numeric_limits<T>::epsilon();
+  const Vec3<T> rp(T(0), T(0), T(1) - eps / T(2));
+  ASSERT_TRUE(valid_pivot(rp));
+  const L r = L(rp.z());
+  const L expected_jacobian = std::pow((1 + r) / (1 - r), 2);  // k / (1 - r)^2 = (1 + r) / (1 - r), squared
+  for (const T len : {T(1) - eps / T(2), T(1), T(1) + eps, T(1) + T(2) * eps}) {
+    const Vec3<T> w(T(0), T(0), len);
+    const Vec3<T> g = pivot_transform(w, rp);
+    EXPECT_TRUE(all_finite(g)) << "|w| - 1 = " << L(len) - 1;
+    EXPECT_LE((g - Vec3<T>(T(0), T(0), T(-1))).norm(), T(4) * eps) << "|w| - 1 = " << L(len) - 1;
+    // k and 1 - r both carry r's rounding (exact here), the squares and the quotient a few eps.
+    EXPECT_NEAR(L(pivot_jacobian(w, rp)) / expected_jacobian, 1, 16 * L(eps)) << "|w| - 1 = " << L(len) - 1;
+  }
+}
+
+TEST(SptdPivot, SphereFormMapsThePivotsDirectionToItsAntipodeForAPivotWithinAnUlpOfTheSphere) {
+  expect_on_pivot_direction_maps_to_antipode<float>();
+  expect_on_pivot_direction_maps_to_antipode<double>();
+  // The vectors of fuzz_sptd_double 262911f1: r_p with 1 - |r_p| = 1.1e-16 and the uniform SPTD over the whole
+  // sphere, whose image is the whole sphere around C's axis w = (-1.49e-8, 0, -1) (|w| = 1 + 1.1e-16), sampled at
+  // u = 0. w is 2e-24 rad off p (with rounding, |w x p| < 1e-23), and g stretches by (1 + r) / (1 - r) = 1.8e16
+  // at p: g(w) lies within 1e-6 rad of -p.
+  const Vec3<double> rp(-1.4901161193847653e-08, -0.0, -0.99999999999999978), w(-1.4901161193847656e-08, 0.0, -1.0);
+  const Vec3<double> p = rp / rp.norm();
+  const Vec3<double> g = pivot_transform(w, rp);
+  ASSERT_TRUE(all_finite(g));
+  EXPECT_NEAR(g.norm(), 1, 4e-16);
+  EXPECT_LT((g + p).norm(), 1e-6);
+  SptdCapGeometry<double> geo;
+  geo.sptd.pivot = rp;
+  geo.cap = Cap<double>{w, 2};
+  const DirectionSample<double> s = sample_sptd_cap(geo, Vec2<double>(0, 0));
+  ASSERT_TRUE(s.valid());
+  EXPECT_LT((s.direction + p).norm(), 1e-6);
+  EXPECT_GT(s.pdf, 0);
+  EXPECT_EQ(s.pdf, pdf_sptd_cap(geo, s.direction));
+}
+
 TEST(SptdPivot, JacobianEq4MatchesFourthOrderFiniteDifferencesInLongDouble) {
   std::mt19937_64 g(12);
   L worst = 0;
@@ -156,7 +199,7 @@ L worst_autodiff_jacobian_error(Transform&& transform, Jacobian&& jacobian) {
 
 TEST(SptdPivot, JacobianEq4MatchesAutodiffOfTheKernelsTransformInLongDouble) {
   auto eq4 = [](const Vec3L& w, const Vec3L& rp) { return pivot_jacobian(w, rp); };
-  // The kernel's sphere form and Eq. 2 verbatim, both differentiated by autodiff (measured worst: 5.4e-19 and
+  // The kernel's sphere form and Eq. 2 verbatim, both differentiated by autodiff (measured worst: 8.7e-19 and
   // 2.3e-16; the verbatim form cancels in its denominator near |r_p| = 1).
   const L sphere_form = worst_autodiff_jacobian_error(
       [](const Vec3<AD>& w, const Vec3<AD>& rp) { return pivot_transform(w, rp); }, eq4);

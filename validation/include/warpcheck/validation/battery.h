@@ -107,11 +107,16 @@ QuadratureResult integrate_adaptive(const std::function<Real(Real)>& f, Real a, 
 // a narrow lobe on a line (a near-singular LTC's, 1e-4 rad wide) can fall between the nodes of a line's first
 // two 15-point rules, which then agree on the tails and stop (measured: the KS azimuth marginal of polygon-ltc
 // near-singular lost 0.23% of the mass with 1 panel, none with one per chi-square ring).
+// abs_tol: an absolute accuracy of the region's integral that is enough (0: none, relative tol alone). Lines
+// that barely touch the support have tiny values, and a relative tolerance there asks for ever more bisections of
+// a jump that the pdf's own rounding blurs (a float pdf): see ks_cdfs.
 QuadratureResult integrate_cap_region_with_error(const std::function<Real(const Vec3L&)>& f, const Cap<Real>& cap,
                                                  Real t0, Real t1, Real phi0, Real phi1, Real tol = 1e-10L,
-                                                 int azimuth_panels = 1, int radial_panels = 1);
+                                                 int azimuth_panels = 1, int radial_panels = 1,
+                                                 const std::vector<Vec3L>& boundary_planes = {}, Real abs_tol = 0);
 Real integrate_cap_region(const std::function<Real(const Vec3L&)>& f, const Cap<Real>& cap, Real t0, Real t1,
-                          Real phi0, Real phi1, Real tol = 1e-10L, int azimuth_panels = 1, int radial_panels = 1);
+                          Real phi0, Real phi1, Real tol = 1e-10L, int azimuth_panels = 1, int radial_panels = 1,
+                          const std::vector<Vec3L>& boundary_planes = {}, Real abs_tol = 0);
 
 // The direction with coordinates (t, phi) in the cap's frame, and back.
 Vec3L cap_direction(const Cap<Real>& cap, Real t, Real phi);

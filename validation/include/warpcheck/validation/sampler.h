@@ -67,6 +67,11 @@ struct SamplerUnderTest {
   Real tolerance = 1e-6L;
   // Why the tolerance differs from 1e-6, if it does (printed in the JSON results).
   std::string tolerance_note;
+  // Optional: great circles (unit normals m of planes through the shading point) on which the pdf may jump or
+  // kink, e.g. a polygon's edges and the horizon. The battery's quadrature splits each radial line where it
+  // crosses one, so that parts of the support thinner than its nodes' spacing (an acute corner's tip) keep
+  // their mass. Without them a polygon seen 0.3 deg from its plane lost 0.25% of its mass.
+  std::vector<Vec3L> boundary_planes;
   // Geometry for which the sampler must decline every sample (e.g. a light entirely below the horizon):
   // the battery then checks only that every sample is declined and the pdf is zero everywhere.
   bool expect_no_sample = false;
