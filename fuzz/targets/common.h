@@ -308,13 +308,15 @@ inline constexpr long double kSubnormalUlps = 16;
 
 // kappa = 1 + max_k (|V_k|_inf + |x|_inf + kSubnormalUlps min_T) / |V_k - x| over the given points (see the
 // header comment). P: the points' type (T, or L for points computed in long double); T: the kernel's precision.
-template <class P, class T = P> L kappa_of(const Vec3<P>* v, int n, const Vec3<P>& x) {
+// subnormal_ulps: kSubnormalUlps, or 0 for a kernel that rescales V - x by a power of two before any other
+// arithmetic (no subnormal intermediate from the coordinates' magnitude; the caller derives it).
+template <class P, class T = P> L kappa_of(const Vec3<P>* v, int n, const Vec3<P>& x, L subnormal_ulps = kSubnormalUlps) {
   L k = 1;
   const Vec3<L> xl = x.template cast<L>();
   for (int i = 0; i < n; ++i) {
     const Vec3<L> vl = v[i].template cast<L>();
     const L dist = (vl - xl).norm();
-    const L mag = vl.cwiseAbs().maxCoeff() + xl.cwiseAbs().maxCoeff() + kSubnormalUlps * L(std::numeric_limits<T>::min());
+    const L mag = vl.cwiseAbs().maxCoeff() + xl.cwiseAbs().maxCoeff() + subnormal_ulps * L(std::numeric_limits<T>::min());
     k = std::max(k, dist > 0 ? mag / dist : std::numeric_limits<L>::infinity());
   }
   return k;

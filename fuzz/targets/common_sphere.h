@@ -72,10 +72,11 @@ template <class T> L sphere_margin(const SphereLightGeometry<T>& g, const Vec3<T
 struct SphereReference {
   L kappa, d, r, cos_max, tol;
 };
-template <class T> SphereReference sphere_reference(const SphereLightGeometry<T>& g) {
+// subnormal_ulps: kappa_of's.
+template <class T> SphereReference sphere_reference(const SphereLightGeometry<T>& g, L subnormal_ulps = kSubnormalUlps) {
   SphereReference s;
   const Vec3<T> c = g.light.center;
-  s.kappa = kappa_of<T>(&c, 1, g.shading.position);
+  s.kappa = kappa_of<T>(&c, 1, g.shading.position, subnormal_ulps);
   s.d = (c.template cast<L>() - g.shading.position.template cast<L>()).norm(), s.r = L(g.light.radius);
   s.cos_max = s.d > s.r && s.r > 0 ? std::sqrt((s.d - s.r) * (s.d + s.r)) / s.d : L(0);
   s.tol = L(kTolUlps) * eps<T>() * s.kappa * (1 + (s.cos_max > 0 ? 1 / s.cos_max : L(0)));

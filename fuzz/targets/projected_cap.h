@@ -168,7 +168,14 @@ template <class T> void check_projected_cap(FuzzedDataProvider& in, const Mutati
                             all_finite(g.shading.normal) && std::isfinite(g.light.radius);
   const ProjectedCapView<T> view = make_projected_cap_view(g);
   const ProjectedCapReference ref = projected_cap_reference(g);
-  const SphereReference sref = sphere_reference(g);
+  // kappa without common.h's subnormal allowance (kSubnormalUlps min_T per coordinate, for kernels whose
+  // intermediates are subnormal when the coordinates are): the kernel's only arithmetic on the coordinates is
+  // d = c - x, whose rounding is at most eps_T |c - x| / 2 per component (exact where the difference is subnormal:
+  // it is a multiple of denorm_min below 2 min_T), covered by kappa's (|c|_inf + |x|_inf) / d >= 1; then it scales d
+  // and r by an exact power of two to |d|_inf in [1/2, 1) (unit_scale_geometry, lib/warpcheck/projected_cap.h), so
+  // every later intermediate is of unit scale. With the allowance a light at 1e-323 had tol ~ 700 rad: the cap
+  // check could not fail there (issue 7, 07252d59).
+  const SphereReference sref = sphere_reference(g, L(0));
   // Cases 1-2: the normaliser is the projected solid angle P(t, theta_max) of the cap. Its conditioning: the
   // kernel knows theta_max to d theta = tan(theta_max) eps kappa (d's relative rounding, sphere_reference) and
   // the angle t to delta t = eps kappa (the direction to the centre). dP/dtheta_max = sin(theta_max) I(theta_max)

@@ -19,6 +19,15 @@
 //      c_z + r_z = (r_y^2 - h^2) / (w_dx r_y - h v)                       (Case 3: h < 0, no cancellation)
 //      s_y^2 = r_y^2 (c_z + r_z)(r_z - c_z + w_z) / (t_y r_z^2 (t_y + d_z))  (Alg. 4's s_y with the common factor
 //              (t_y - d_z) cancelled: no 0/0 at the top of the lune, no clamping needed there)
+//            = (t_y + m d_z) / (t_y + d_z),  m = (c_z + r_z) / (r_z - c_z)
+//              (using (c_z + r_z)(r_z - c_z) = r_y^2 - h^2 = t_y^2 w_dx^2 and r_z = w_dx r_y), so that
+//      1 - s_y^2 = (1 - m) d_z / (t_y + d_z),  1 - m = -2 h v / (r_z - c_z) >= 0,
+//      1 - k^2 = 1 - (r_y^2 - h^2) w_dx^2 / (r_z - c_z)^2 = -h (2 v w_dx r_y - h (v^2 + w_dx^2)) / (r_z - c_z)^2 >= 0
+//              (Case 3, h < 0; k = (c_z + r_z) / t_y), and Case 3's lift, d on the unit sphere and w = (w_x, s_y d_y, k d_z):
+//      w_x^2 = 1 - w_y^2 - w_z^2 = d_x^2 + (1 - s_y^2) d_y^2 + (1 - k^2) d_z^2,
+//    a sum of non-negative terms where 1 - w_y^2 - w_z^2 cancels for a sample near the lune's flat side (w_x ~ 0,
+//    e.g. a cap of 90 deg - 0.02 deg with its centre on the horizon, fuzz_projected_cap_double 71f5a077). The
+//    identities are ours (not in the paper); at h = 0 they give the identity warp the paper notes (Sec. 3.5).
 //    and areas of cut disks from angles: the unit disk's area right of x = cos(theta) is
 //      C(theta) = theta - sin(theta) cos(theta) = (2 theta - sin 2 theta) / 2,
 //    evaluated by its Taylor series for small theta (it is ~ 2 theta^3 / 3; the difference form cancels).
@@ -237,6 +246,9 @@ template <class T> struct ProjectedCapView {
   // Case 3: z scale k = (c_z + r_z) / t_y, c_z + r_z and r_z - c_z. Cases 1-2: c_z - r_z, the height of the
   // ellipse's point d_x = 1 (lowest point of the cap's boundary), = (h^2 - r_y^2) / (h v + w_dx r_y).
   T k = T(0), top = T(0), rz_minus_cz = T(0), cz_minus_rz = T(0);
+  // Case 3: s_y^2 = (t_y + m d_z) / (t_y + d_z) with m = (c_z + r_z) / (r_z - c_z), its 1 - m, and 1 - k^2
+  // (header comment; each >= 0, so the lune's w_x is a sum of squares).
+  T sy_m = T(0), sy_one_minus_m = T(0), one_minus_k2 = T(0);
   // 1 - c_x = 1 - w_dx v = (h^2 + w_dx^2 r_y^2) / (1 + w_dx v), for the inverse of the ellipse piece.
   T one_minus_cx = T(0);
 
@@ -247,10 +259,46 @@ template <class T> struct ProjectedCapView {
   T projected_solid_angle_if_uniform() const { return which_case <= 2 ? total : T(0); }
 };
 
+namespace projected_cap_detail {
+
+// Scale invariance (our change, not in the paper). Alg. 1 reads the light only through w_d = d / |d| and
+// r_y = r / |d|, d = c - x, which do not change when d and r are multiplied by the same power of two; that product
+// is exact (barring underflow). make_sphere_view forms |d|, d / |d| and r / |d| in T, which is accurate for d in
+// T's normal range but not for subnormal coordinates, where every intermediate carries an absolute rounding of
+// denorm_min / 2: d = (1, 3, -1) denorm_min has |d| = sqrt(11) denorm_min, rounded to 3 denorm_min, so w_d came
+// out of length 1.106 and r_y = 2/3 instead of 0.603 (fuzz_projected_cap_double 07252d59, 8df1478e, issue 7).
+// The view is therefore built from x' = 0, c' = d 2^-e and r' = r 2^-e with |d|_inf in [1/2, 1): every later
+// quantity (|d'|, r' / |d'|, squares) is of unit scale, whatever the coordinates' magnitude (subnormal, or ~1e209
+// where |d|^2 overflows). d itself is formed in T from the inputs, as before: its rounding is the input's
+// conditioning (exact when the difference is subnormal). r' is capped at 4 (> |d'| <= sqrt(3): x inside the light
+// either way, no overflow) and at least denorm_min (r' / |d'| then squares to 0: kTooSmall, as unscaled).
+// Returns the exponent e (0 where the geometry is passed on unchanged for make_sphere_view to reject).
+template <class T> int unit_scale_geometry(const SphereLightGeometry<T>& g, SphereLightGeometry<T>& out) {
+  out = g;
+  const T r = g.light.radius;
+  if (!all_finite(g.light.center) || !all_finite(g.shading.position) || !std::isfinite(r) || !(r > T(0))) return 0;
+  const Vec3<T> d = g.light.center - g.shading.position;
+  if (!all_finite(d)) return 0;  // the difference overflowed
+  const T m = d.cwiseAbs().maxCoeff();
+  if (!(m > T(0))) return 0;  // x at the centre: inside the light
+  int e = 0, er = 0;
+  std::frexp(m, &e);
+  std::frexp(r, &er);  // r < 2^er
+  out.shading.position = Vec3<T>::Zero();
+  out.light.center = Vec3<T>(std::ldexp(d.x(), -e), std::ldexp(d.y(), -e), std::ldexp(d.z(), -e));
+  out.light.radius = er - e > 2 ? T(4) : std::max(std::ldexp(r, -e), std::numeric_limits<T>::denorm_min());
+  return e;
+}
+
+}  // namespace projected_cap_detail
+
 template <class T> ProjectedCapView<T> make_projected_cap_view(const SphereLightGeometry<T>& g) {
   ProjectedCapView<T> p;
-  p.sphere = make_sphere_view(g);
+  SphereLightGeometry<T> unit;
+  const int scale_exponent = projected_cap_detail::unit_scale_geometry(g, unit);
+  p.sphere = make_sphere_view(unit);
   if (!p.sphere.valid()) return p.reason = p.sphere.reason, p;
+  p.sphere.distance = std::ldexp(p.sphere.distance, scale_exponent);  // |c - x| in the caller's units
   const SphereView<T>& s = p.sphere;
   const Vec3<T> wd = s.frame.z;
   p.z = s.normal;
@@ -323,6 +371,13 @@ template <class T> ProjectedCapView<T> make_projected_cap_view(const SphereLight
       p.rz_minus_cz = p.w_dx * ry - h * v;
       p.top = chord2 / p.rz_minus_cz;                          // c_z + r_z
       p.k = std::sqrt(chord2) * p.w_dx / p.rz_minus_cz;        // (c_z + r_z) / t_y
+      // Header comment (Case 3 without cancellation): m = (c_z + r_z) / (r_z - c_z), 1 - m = -2 h v / (r_z - c_z),
+      // 1 - k^2 = q (2 v w_dx r_y / (r_z - c_z) - h (v^2 + w_dx^2) / (r_z - c_z)) with q = -h / (r_z - c_z); all
+      // terms >= 0 for h < 0, and no square of r_z - c_z (which underflows for r_y ~ 1e-154).
+      p.sy_m = p.top / p.rz_minus_cz;
+      p.sy_one_minus_m = T(-2) * h * v / p.rz_minus_cz;
+      const T q3 = -h / p.rz_minus_cz;
+      p.one_minus_k2 = q3 * (T(2) * v * p.w_dx * (ry / p.rz_minus_cz) + q3 * (v * v + p.w_dx * p.w_dx));
       p.total = p.area_d;
       p.tau = T(0);
     }
@@ -335,20 +390,19 @@ template <class T> ProjectedCapView<T> make_projected_cap_view(const SphereLight
 
 namespace projected_cap_detail {
 
-// Case 3 (Alg. 4): s_y from d_z and w_z = k d_z, in the cancelled form (see the header comment).
-template <class T> T case3_sy(const ProjectedCapView<T>& p, T d_z, T w_z) {
-  const T num = p.r_y * p.r_y * p.top * (p.rz_minus_cz + w_z);
-  const T den = p.t_y * p.r_z * p.r_z * (p.t_y + d_z);
-  // den underflows to 0 for a lune below T's range (t_y or r_z ~ 1e-160): no width there rather than a
-  // division by zero (found by fuzz_projected_cap_double under UBSan's float-divide-by-zero, issue 7).
-  return den > T(0) ? std::sqrt(std::max(T(0), num / den)) : T(0);
-}
-
-// w_z = sqrt(1 - w_x^2 - w_y^2) for a point of the unit disk (used only for the Case-3 w_x, where no better
-// form is known; see disk_to_local). Near the rim the sum of squares (rounding ~1.5 eps) is as accurate as
-// (1 - rho)(1 + rho) with rho = hypot, and hypot's overflow care is not needed for |w| <= 1.
-template <class T> T lift(T wx, T wy) {
-  return std::sqrt(std::max(T(0), T(1) - (wx * wx + wy * wy)));
+// Case 3 (Alg. 4): s_y at d_z, s_y^2 = (t_y + m d_z) / (t_y + d_z), and 1 - s_y^2 = (1 - m) d_z / (t_y + d_z), both
+// without cancellation (header comment). t_y + d_z >= t_y >= sqrt(denorm_min) wherever Case 3 has an area (r_y^2 -
+// h^2 > 0), so its reciprocal is finite; the guard keeps a lune without width from dividing by zero (found by
+// fuzz_projected_cap_double under UBSan's float-divide-by-zero, issue 7).
+template <class T> struct Case3Sy {
+  T s_y, one_minus_sy2;
+};
+template <class T> Case3Sy<T> case3_sy(const ProjectedCapView<T>& p, T d_z) {
+  const T den = p.t_y + d_z;
+  if (!(den > T(0))) return {T(0), T(0)};
+  const T inv = T(1) / den;
+  const T r = d_z * inv;  // in [0, 1]
+  return {std::sqrt(p.t_y * inv + p.sy_m * r), p.sy_one_minus_m * r};
 }
 
 // Piece geometry: 0 ellipse, 1 mirrored disk, 2 Case-3 lune. Maps a cut-disk point to a local direction and
@@ -383,10 +437,14 @@ Local<T> disk_to_local(const ProjectedCapView<T>& p, int piece, T dx, T hh, T u1
     o.w = Vec3<T>(-dx, dy, d_z);
     o.pdf_proj = T(1) / inv_disk_density;
   } else {
+    // 1 - w_y^2 - w_z^2 = d_x^2 + (1 - s_y^2) d_y^2 + (1 - k^2) d_z^2 on the unit sphere: a sum of squares (header
+    // comment), where 1 - w_y^2 - w_z^2 lost eps / w_x^2 of w_x's digits (a Case-3 sample pdf 2e-9 off at
+    // w_x = 3.5e-4, fuzz_projected_cap_double 71f5a077; 2e-5 at w_x = 1.5e-6, 8b269b33; issue 7).
     const T w_z = p.k * d_z;
-    const T s_y = case3_sy(p, d_z, w_z);
+    const Case3Sy<T> sy = case3_sy(p, d_z);
+    const T s_y = sy.s_y;
     const T w_y = s_y * dy;
-    const T w_x = lift(w_y, w_z);
+    const T w_x = std::sqrt(dx * dx + sy.one_minus_sy2 * (dy * dy) + p.one_minus_k2 * (d_z * d_z));
     o.w = Vec3<T>(w_x, w_y, w_z);
     // Alg. 4: p = -t_y^2 / ((c_z + r_z)^2 A_D) w_x / (d_x s_y) = w_x / (k^2 s_y |d_x|) per unit disk density.
     // Where the lune has no width in T (s_y = 0) or d_x = 0 the density is not representable: 0, which the
@@ -422,10 +480,14 @@ template <class T> bool local_to_disk(const ProjectedCapView<T>& p, int piece, c
   } else {
     if (!(w.x() > T(0))) return false;
     const T d_z = w.z() / p.k;
-    const T s_y = case3_sy(p, d_z, w.z());
-    if (!(s_y > T(0))) return false;
+    const Case3Sy<T> sy = case3_sy(p, d_z);
+    const T s_y = sy.s_y;
+    if (!(s_y > T(0)) || !(d_z <= T(1))) return false;
     dy = w.y() / s_y;
-    const T rest = (T(1) - d_z) * (T(1) + d_z) - dy * dy;
+    // d_x^2 = 1 - d_y^2 - d_z^2 = w_x^2 - (1 - s_y^2) d_y^2 - (1 - k^2) d_z^2 for a unit w (disk_to_local's identity):
+    // rounding eps w_x^2 instead of eps, i.e. within the inherent 2 eps w_x of w_x's own digits (d_x ~ w_x near
+    // the lune's flat side, where the warp is near the identity).
+    const T rest = w.x() * w.x() - sy.one_minus_sy2 * (dy * dy) - p.one_minus_k2 * (d_z * d_z);
     if (!(rest >= T(0))) return false;
     dx = -std::sqrt(rest);
     area_factor = p.k * p.k * s_y * std::abs(dx) / w.x();
@@ -496,9 +558,18 @@ template <class T, CutDiskInverse M> T pdf_local(const ProjectedCapView<T>& p, c
     T dx, dy, hh, area;
     if (!local_to_disk(p, pc.kind, w, dx, dy, hh, area)) continue;
     const CutDiskPreimage<T> pre = cut_disk_preimage<T, M>(dx, hh);
-    const T a_lo = std::min(piece_left_area(pc, pc.u_lo), piece_left_area(pc, pc.u_hi));
-    const T a_hi = std::max(piece_left_area(pc, pc.u_lo), piece_left_area(pc, pc.u_hi));
-    if (pre.left_area < a_lo || pre.left_area > a_hi) continue;
+    // A piece a = beta u0 (alpha = 0) covers left-areas [0, beta u_hi], i.e. right-areas >= right_hi; compared as
+    // right-areas, because its end is near pi, where left-areas lose the cut: a Case-2 disk piece of area 6.4e-16
+    // lies within one ulp of pi (4.4e-16) in left-area, so the ellipse piece claimed all of it and pdf() returned
+    // the ellipse's density there (sample pdf 0.55 x pdf(direction), tau = 1 - 2^-53 for a share of 2.0e-16;
+    // confirming campaign of issue 7, 2026-12-02). The other pieces (a = alpha (1 - u0) <= pi/2) keep left-areas.
+    if (pc.alpha == T(0)) {
+      if (pre.right_area < pc.right_hi) continue;
+    } else {
+      const T a_lo = std::min(piece_left_area(pc, pc.u_lo), piece_left_area(pc, pc.u_hi));
+      const T a_hi = std::max(piece_left_area(pc, pc.u_lo), piece_left_area(pc, pc.u_hi));
+      if (pre.left_area < a_lo || pre.left_area > a_hi) continue;
+    }
     if (u) {
       (*u)[0] = std::clamp(pc.alpha == T(0) ? pre.left_area / pc.beta : T(1) - pre.left_area / pc.alpha, pc.u_lo, pc.u_hi);
       (*u)[1] = hh > T(0) ? std::clamp((dy / hh + T(1)) / T(2), T(0), T(1)) : T(0.5);
