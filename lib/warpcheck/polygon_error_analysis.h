@@ -54,8 +54,7 @@ template <class T> T decentral_backward_error(const RandomSectorCase<T>& c, int 
 template <class T> T decentral_backward_error_biased(const RandomSectorCase<T>& c) {
   ProjectedSector<T> approx = c.sector;
   const T cross = kahan_cross2(approx.s0, approx.s1);
-  approx.area = ellipse_sector_area<T, true>(approx.outer, approx.s0, approx.s1, cross) -
-                ellipse_sector_area<T, true>(approx.inner, approx.s0, approx.s1, cross);
+  approx.area = area_between_ellipses<T, true>(approx, approx.s0, approx.s1, cross);
   const T target = c.target / c.sector.area * approx.area;  // the same xi within the sector
   const Vec2<T> w = invert_decentral_sector<T, true>(approx, target, 0);
   return std::abs(decentral_residual<T, false>(c.sector, c.target, w)) / c.sector.area;

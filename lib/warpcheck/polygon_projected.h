@@ -171,18 +171,21 @@ template <class T> Vec2<T> l1_normalized(const Vec2<T>& w) {
   return s > T(0) && std::isfinite(s) ? Vec2<T>(w / s) : w;
 }
 
+// Eq. 1 applied to both ellipses of a decentral sector: the area between them from a counterclockwise to b,
+// given cross = a x b.
+template <class T, bool kBiased = false>
+T area_between_ellipses(const ProjectedSector<T>& s, const Vec2<T>& a, const Vec2<T>& b, T cross) {
+  return ellipse_sector_area<T, kBiased>(s.outer, a, b, cross) - ellipse_sector_area<T, kBiased>(s.inner, a, b, cross);
+}
+
 // The area between the ellipses in the sector from s0 to w (the subtracted terms of Eq. 7).
 template <class T, bool kBiased = false> T decentral_area_to(const ProjectedSector<T>& s, const Vec2<T>& w) {
-  const T cross = kahan_cross2(s.s0, w);
-  return ellipse_sector_area<T, kBiased>(s.outer, s.s0, w, cross) -
-         ellipse_sector_area<T, kBiased>(s.inner, s.s0, w, cross);
+  return area_between_ellipses<T, kBiased>(s, s.s0, w, kahan_cross2(s.s0, w));
 }
 
 // The area between the ellipses in the sector from w to s1.
 template <class T, bool kBiased = false> T decentral_area_from(const ProjectedSector<T>& s, const Vec2<T>& w) {
-  const T cross = kahan_cross2(w, s.s1);
-  return ellipse_sector_area<T, kBiased>(s.outer, w, s.s1, cross) -
-         ellipse_sector_area<T, kBiased>(s.inner, w, s.s1, cross);
+  return area_between_ellipses<T, kBiased>(s, w, s.s1, kahan_cross2(w, s.s1));
 }
 
 // Eq. 7: residual A_delta(w) = A - area(s0 -> w), measured from the sector's nearer end: for A beyond half the
@@ -446,8 +449,7 @@ template <class T, bool kBiased = false> PolygonProjectedView<T> make_polygon_pr
       cur = s.s1;
       const T cross = kahan_cross2(s.s0, s.s1);
       const T sine = cross > T(0) ? cross : T(0);  // a sector is at most 180 degrees: clamp rounding
-      s.area = std::max(T(0), ellipse_sector_area<T, kBiased>(s.outer, s.s0, s.s1, sine) -
-                                  ellipse_sector_area<T, kBiased>(s.inner, s.s0, s.s1, sine));
+      s.area = std::max(T(0), area_between_ellipses<T, kBiased>(s, s.s0, s.s1, sine));
     }
   }
   T total = 0;

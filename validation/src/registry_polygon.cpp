@@ -265,11 +265,12 @@ std::vector<PolygonConfig> configs() {
 //    2 pi) cancel: 1 cm, 0 (Arvo: no samples) and -2.4e-7 (Urena) for 5.3e-8 sr; 1 mm, 0 and 2.4e-7 for 5.3e-10.
 const char* polygon_known_limitation(const std::string& kernel, const std::string& scalar, const std::string& config) {
   if (config == "below-horizon") return "";
-  if (scalar == "float" && (config == "far-1cm" || config == "far-1mm") && (kernel == "baseline-arvo-triangle" || kernel == "baseline-urena-rectangle"))
+  const bool angle_sum_baseline = kernel == "baseline-arvo-triangle" || kernel == "baseline-urena-rectangle";
+  if (scalar == "float" && (config == "far-1cm" || config == "far-1mm") && angle_sum_baseline)
     return "as published, the baseline's solid angle (a sum of angles minus pi or 2 pi) cancels in float on the 1 cm "
            "and 1 mm lights 40 m away (1 cm: Arvo 0, i.e. no samples, Urena -2.4e-7 for 5.3e-8 sr; 1 mm: Arvo 0, Urena 2.4e-7 "
            "for 5.3e-10); a baseline, not fixed";
-  if (scalar == "float" && config == "nearly-edge-on" && (kernel == "baseline-arvo-triangle" || kernel == "baseline-urena-rectangle"))
+  if (scalar == "float" && config == "nearly-edge-on" && angle_sum_baseline)
     return "as published, the baseline's solid angle (a sum of angles minus pi or 2 pi) cancels in float for a "
            "square seen 0.3 deg from its plane: normaliser off by 2.6e-4 (Arvo) and 3.8e-3 (Urena), hence chi2, KS "
            "and pdf-integral; double passes; a baseline, not fixed";
@@ -308,9 +309,10 @@ void add_case(Registry& r, const char* kernel, const PolygonConfig& c, Measure m
     s.kinks_u0 = K<Real>::kinks_u0(c.g);
     // Breakpoints only for slivers (thinner than a sixteenth of the bounding cap's radius, the default grid's
     // ring spacing): they multiply the quadrature's cost (measured on central-square, projected kernel: double,
-    // 1000 samples, 19.9 s -> 78.6 s of CPU; float at 1e7 samples 14 min of CPU with them, no comparison run; the
-    // float pdf's jumps lie off the long double planes, likely the cause), and the default nodes already resolve
-    // every other configuration (the double battery of 9ec2b69 passed them all).
+    // 1000 samples, 19.9 s -> 78.6 s of CPU), and the default nodes already resolve every other configuration
+    // (the double battery of 9ec2b69 passed them all). In float they cost most in the KS rings, whose lines
+    // barely touching the support ran to their panel budget until ks_cdfs got an absolute tolerance (battery.cpp:
+    // nearly-edge-on float, 1136 s -> 160 s of CPU in the rings).
     const Real theta_max = std::acos(std::clamp<Real>(1 - s.bounding_cap.one_minus_cos, -1, 1));
     // The great circles on which the pdfs jump or kink: the edges' planes and the horizon (where the clipped
     // kernels' supports end and the projected density's cosine reaches 0).

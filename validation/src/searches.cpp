@@ -79,7 +79,7 @@ std::optional<RandomSectorCase<L>> sector_case(std::span<const L> p, L min_area)
   // The sector's area exactly as make_polygon_projected_view computes it.
   const L cross = kahan_cross2(s.s0, s.s1);
   const L sine = cross > 0 ? cross : L(0);
-  s.area = std::max(L(0), ellipse_sector_area<L>(s.outer, s.s0, s.s1, sine) - ellipse_sector_area<L>(s.inner, s.s0, s.s1, sine));
+  s.area = std::max(L(0), area_between_ellipses<L>(s, s.s0, s.s1, sine));
   if (!(s.area >= min_area)) return std::nullopt;
   return RandomSectorCase<L>{s, p[5] * s.area};
 }
