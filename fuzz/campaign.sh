@@ -30,7 +30,7 @@ Per target, afterwards:
     published baseline, which the replay runs without asserting its outcome);
   - data/fuzz/summary.json gets (or replaces) the target's entry: minutes, jobs, executions, exec/s, cov and ft
     as libFuzzer last reported them, corpus sizes, the number of artifacts, of those triaged and of those skipped as known, the findings
-    stored, the date and this command line.
+    stored, the date, this command line and the commit of lib/ and fuzz/ ("+changes" if edited).
 Logs and the campaign's working corpus stay in DIR/campaign/TARGET/.
 EOF
 }
@@ -151,10 +151,14 @@ for target in "${TARGETS[@]}"; do
   unset seen
   findings_json="${findings_json%,}]"
 
-  python3 - "$ROOT/data/fuzz/summary.json" "$target" "$MINUTES" "$JOBS" "$seconds" "$stats" "$before" "$after" \
-    "$findings_json" "$COMMAND_LINE" "$n_artifacts" "$n_triaged" "$n_known" <<'PY'
+  # Under a lock: two campaigns over disjoint targets may run at once (one per core) and both rewrite the file.
+  commit="$(git -C "$ROOT" rev-parse --short HEAD 2>/dev/null || echo unknown)"
+  [[ -z "$(git -C "$ROOT" status --porcelain --untracked-files=no -- lib fuzz 2>/dev/null)" ]] || commit+="+changes"
+  flock "$ROOT/data/fuzz/.summary.lock" python3 - "$ROOT/data/fuzz/summary.json" "$target" "$MINUTES" "$JOBS" \
+    "$seconds" "$stats" "$before" "$after" "$findings_json" "$COMMAND_LINE" "$n_artifacts" "$n_triaged" "$n_known" \
+    "$commit" <<'PY'
 import json, os, re, sys, datetime
-path, target, minutes, jobs, seconds, stats, before, after, findings, command, n_art, n_tri, n_known = sys.argv[1:]
+path, target, minutes, jobs, seconds, stats, before, after, findings, command, n_art, n_tri, n_known, commit = sys.argv[1:]
 summary = {"description": "libFuzzer campaigns (fuzz/campaign.sh); per target the last campaign's numbers as "
                           "libFuzzer's fork mode last reported them", "targets": {}}
 if os.path.exists(path):
@@ -172,7 +176,7 @@ summary["targets"][target] = {
     "crash_artifacts": int(n_art), "artifacts_triaged": int(n_tri), "artifacts_known": int(n_known),
     "findings": json.loads(findings),
     "date": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
-    "command": command,
+    "command": command, "commit": commit,
 }
 with open(path, "w") as f:
     json.dump(summary, f, indent=2, sort_keys=True)
