@@ -87,7 +87,13 @@ template <class T> LtcPolygonView<T> make_ltc_polygon_view(const LtcPolygonGeome
   if (!invertible || !(v.det > T(0)) || !std::isfinite(v.det)) return v.reason = NoSample::kInvalidGeometry, v;
   v.det_inv = T(1) / v.det;
   if (!v.m_inv.allFinite() || !std::isfinite(v.det_inv)) return v.reason = NoSample::kInvalidGeometry, v;
-  v.transformed = make_polygon_projected_view(ltc_transformed_polygon(pv, v.m_inv));
+  // M^-1 P is convex, but its computed vertices carry the rounding of the frame change (a few eps |v|) and of
+  // the product: 3 eps |M^-1|_F |v|_2 <= 3 eps cond_F(M) |M^-1 v|_2 <= 3 sqrt(3) eps cond_F(M) |M^-1 v|_inf.
+  // check_polygon forgives reflex turns up to that rounding (and no further: polygon.h).
+  const T eps = std::numeric_limits<T>::epsilon();
+  const T cond = g.m.norm() * v.m_inv.norm();
+  const T rounding = kPolygonVertexRounding<T> + T(3) * std::sqrt(T(3)) * eps * cond;
+  v.transformed = make_polygon_projected_view(ltc_transformed_polygon(pv, v.m_inv), rounding);
   if (!v.transformed.valid()) return v.reason = v.transformed.reason, v;
   v.integral = v.transformed.projected_solid_angle / kPi<T>;
   return v;

@@ -10,7 +10,7 @@
 //   spherical_rectangle.h  Urena et al. 2013 (rectangles only)
 //
 // Conventions. A polygon has 3 to 8 vertices in world space, in either winding, and must be planar and
-// convex, planar to 8 sqrt(eps) of its width (plus its coordinates' rounding), and wider than that tolerance.
+// convex up to its coordinates' rounding, planar to 8 sqrt(eps) of its width (plus that rounding), and wider than the planarity tolerance.
 // check_polygon() is the validating constructor's test: it returns kInvalidGeometry or kZeroSize (and a message)
 // for anything else. Every kernel calls it, so no kernel ever samples invalid input.
 #pragma once
@@ -102,8 +102,16 @@ template <class T> Vec3<T> polygon_area_vector(const PolygonLight<T>& p) {
   return n;  // = 2 * area * unit normal (right-hand rule)
 }
 
+// The relative rounding of input vertex coordinates that check_polygon forgives in a reflex turn, by default: half
+// an ulp per coordinate is eps / 2 of |V|_inf; 4 eps leaves room for a conversion or a transform before us.
+template <class T> constexpr T kPolygonVertexRounding = T(4) * std::numeric_limits<T>::epsilon();
+
 // kNone for a valid light; otherwise kNonFinite, kZeroSize or kInvalidGeometry, with a message if asked.
-template <class T> NoSample check_polygon(const PolygonLight<T>& p, std::string* message = nullptr) {
+// vertex_rounding: each vertex V_k is known to vertex_rounding |V_k|_inf (a caller that computed the vertices,
+// such as ltc.h's M^-1 P, passes its own bound).
+template <class T>
+NoSample check_polygon(const PolygonLight<T>& p, std::string* message = nullptr,
+                       T vertex_rounding = kPolygonVertexRounding<T>) {
   auto fail = [&](NoSample r, const char* why) {
     if (message) *message = why;
     return r;
@@ -145,12 +153,22 @@ template <class T> NoSample check_polygon(const PolygonLight<T>& p, std::string*
       return fail(NoSample::kInvalidGeometry, "vertices are not coplanar");
   // Convexity: every turn goes the same way as the area vector, and the turns add up to one revolution
   // (rejects star polygons such as a pentagram, whose turns all agree but add up to two).
+  // A reflex turn is forgiven only as far as the input's rounding explains it. Vertex k is known to
+  // delta_k = vertex_rounding |V_k|_inf, so a = V_i - V_{i-1} is off by at most delta_{i-1} + delta_i, b by
+  // delta_i + delta_{i+1}, and s = nhat . (a x b) by |a| err_b + |b| err_a + err_a err_b. Not the planarity
+  // tolerance: that one is a length, so an edge shorter than it could point anywhere, and every kernel's
+  // inside test (the planes through x and each edge, polygon_inward_planes) would then cut a slice off the
+  // light that its sampler still samples: pdf() 0 at its own samples (fuzz_ltc_double a8864f7e..., d3e18c5b...,
+  // 1e7d91f3...: edges of length 7.5e-9 to 8 reflex by up to 0.8 rad in lights of diameter 16 to 1e14; issue 7).
+  auto rounding = [&](int k) { return vertex_rounding * p.vertices[(k + p.count) % p.count].cwiseAbs().maxCoeff(); };
   T turning = 0;
   for (int i = 0; i < p.count; ++i) {
     const Vec3<T> a = p.vertices[i] - p.vertices[(i + p.count - 1) % p.count];
     const Vec3<T> b = p.vertices[(i + 1) % p.count] - p.vertices[i];
     const T s = nhat.dot(kahan_cross<T>(a, b)), c = a.dot(b);
-    if (s < -tol * (a.norm() + b.norm())) return fail(NoSample::kInvalidGeometry, "polygon is not convex");
+    const T err_a = rounding(i - 1) + rounding(i), err_b = rounding(i) + rounding(i + 1);
+    if (s < -(a.norm() * err_b + b.norm() * err_a + err_a * err_b))
+      return fail(NoSample::kInvalidGeometry, "polygon is not convex");
     turning += std::atan2(s, c);
   }
   if (std::abs(turning - kTwoPi<T>) > T(0.5)) return fail(NoSample::kInvalidGeometry, "polygon is not simple");
@@ -203,11 +221,13 @@ template <class T> struct PolygonView {
 
 // Validates the input and expresses the polygon in the shading frame. Edge-on (x in the plane of the light,
 // which includes x on the light) gives kEdgeOn.
-template <class T> PolygonView<T> make_polygon_view(const PolygonLightGeometry<T>& g) {
+// vertex_rounding: as for check_polygon.
+template <class T>
+PolygonView<T> make_polygon_view(const PolygonLightGeometry<T>& g, T vertex_rounding = kPolygonVertexRounding<T>) {
   PolygonView<T> v;
   if (!all_finite(g.shading.position)) return v.reason = NoSample::kNonFinite, v;
   if (!all_finite(g.shading.normal)) return v.reason = NoSample::kNonFinite, v;
-  if (const NoSample r = check_polygon(g.light); r != NoSample::kNone) return v.reason = r, v;
+  if (const NoSample r = check_polygon(g.light, nullptr, vertex_rounding); r != NoSample::kNone) return v.reason = r, v;
   if (!normalize_normal(g.shading.normal, v.normal)) return v.reason = NoSample::kBadNormal, v;
   v.frame = Frame<T>::from_z(v.normal);
   v.plane_normal = safe_normalized(polygon_area_vector(g.light));

@@ -363,9 +363,12 @@ template <class T> bool winds_around_zenith(const LocalPolygon<T>& p) {
   return sum > kPi<T>;
 }
 
-template <class T, bool kBiased = false> PolygonProjectedView<T> make_polygon_projected_view(const PolygonLightGeometry<T>& g) {
+// vertex_rounding: as for check_polygon (polygon.h).
+template <class T, bool kBiased = false>
+PolygonProjectedView<T> make_polygon_projected_view(const PolygonLightGeometry<T>& g,
+                                                    T vertex_rounding = kPolygonVertexRounding<T>) {
   PolygonProjectedView<T> v;
-  const PolygonView<T> pv = make_polygon_view(g);
+  const PolygonView<T> pv = make_polygon_view(g, vertex_rounding);
   if (!pv.valid()) return v.reason = pv.reason, v;
   v.frame = pv.frame;
   v.flip_y = pv.plane_distance < T(0);

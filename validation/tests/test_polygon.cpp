@@ -550,6 +550,37 @@ TYPED_TEST(PolygonKernels, ThinPolygonsArePlanarRelativeToTheirWidth) {
   }
 }
 
+// check_polygon forgives a reflex turn only as far as the vertices' rounding explains it. Its old tolerance was a
+// length (8 sqrt(eps) of the width), so a notch behind a short edge passed, and every kernel's inside test (the
+// planes through the edges) then cut a slice off the light that the samplers still sampled (fuzz_ltc_double
+// a8864f7e..., d3e18c5b..., 1e7d91f3..., issue 7). A vertex collinear up to rounding stays valid.
+TYPED_TEST(PolygonKernels, AReflexNotchBehindAShortEdgeIsNotConvexButACollinearVertexWithinRoundingIs) {
+  using T = TypeParam;
+  const T eps = std::numeric_limits<T>::epsilon();
+  std::string message;
+  // A unit square at z = 1 with a notch of depth h at its corner (0, 0): the vertex (h, h) between (0, 1) and
+  // (0, 0). The turn there is reflex with s = -h; the old tolerance, about 8 sqrt(eps) here, accepted h below it.
+  const T h = std::is_same_v<T, float> ? T(1e-4) : T(1e-9);
+  ASSERT_LT(h, T(8) * std::sqrt(eps));
+  const PolygonLight<T> notch{Vec3<T>(0, 0, 1), Vec3<T>(1, 0, 1), Vec3<T>(1, 1, 1), Vec3<T>(0, 1, 1), Vec3<T>(h, h, 1)};
+  EXPECT_EQ(check_polygon(notch, &message), NoSample::kInvalidGeometry);
+  EXPECT_NE(message.find("not convex"), std::string::npos) << message;
+  for (NoSample r : all_reasons(geom<T>(Vec3<T>(0.5, 0.5, 0), Vec3<T>(0, 0, 1), notch)))
+    EXPECT_EQ(r, NoSample::kInvalidGeometry) << to_string(r);
+  // A vertex on the bottom edge, off the line by an ulp of its coordinates to either side: valid.
+  for (const T y : {T(0), eps, -eps}) {
+    const PolygonLight<T> mid{Vec3<T>(0, 0, 1), Vec3<T>(T(0.5), y, 1), Vec3<T>(1, 0, 1), Vec3<T>(1, 1, 1), Vec3<T>(0, 1, 1)};
+    EXPECT_EQ(check_polygon(mid, &message), NoSample::kNone) << double(y) << ": " << message;
+  }
+  // fuzz_ltc_double 1e7d91f3...: an edge of length 7.5e-9 reflex by 0.016 rad in a light of size 16.
+  if constexpr (!std::is_same_v<T, float>) {
+    const PolygonLight<T> fuzzed{Vec3<T>(T(-7.4505805969238281e-09), 0, 0), Vec3<T>(0, 0, T(15.99951171875)),
+                                 Vec3<T>(T(15.99951171875), T(-0.375), -1), Vec3<T>(0, 0, 0)};
+    EXPECT_EQ(check_polygon(fuzzed, &message), NoSample::kInvalidGeometry);
+    EXPECT_NE(message.find("not convex"), std::string::npos) << message;
+  }
+}
+
 // Sec. 3.1 / Fig. 3b: the sectors cover the whole light when an edge of sign 0 lies inside a chain. A triangle
 // with a collinear extra vertex (a doubled vertex 2.2e-16 away, on the same vertical line as the clip point), cut
 // by the horizon: the inner chain used to stop at that edge, A_Sigma 9.3e-22 instead of 1.57e-4 (fuzz_ltc_double
