@@ -117,7 +117,17 @@ template <class T> T pivot_jacobian(const Vec3<T>& w, const Vec3<T>& rp, T k) {
 template <class T> T pivot_jacobian(const Vec3<T>& w, const Vec3<T>& rp) { return pivot_jacobian(w, rp, pivot_k(rp)); }
 
 // Eqs. 6-7 (with the orientation fix described in the header): the cap g(C).
-template <class T> Cap<T> pivot_transform_cap(const Cap<T>& c, const Vec3<T>& rp, T k) {
+// axis_minus_pivot: if given, set to the image axis minus r_p, accurate to rounding of its own size, when the image
+// is a small cap (below 30 degrees; else left unset and false returned in *relative). Such an image lies near r_p's
+// direction when |r_p| is near 1, and a unit vector there is rounded by eps, which g stretches by k / |w - r_p|^2
+// on the way back (Eq. 4; 1700 for |r_p| = 0.999, registry case pivot-0.999-away). Derived here: g1 - r_p =
+// k o1 / |o1|^2 with o1 = pivot_offset(p1) = r_p - p1 (the anti-inversion form); the image circle's centre is the
+// midpoint m = r_p + h of g1 and g2 (the ends of a diameter), h = (q1 + q2) / 2 with q_i = g_i - r_p; the axis is
+// m / |m|, so axis - r_p = h + m (1 - |m|) / |m|, and as |r_p + q_i| = 1, 1 - |m|^2 = |q1 - q2|^2 / 4 exactly.
+template <class T>
+Cap<T> pivot_transform_cap(const Cap<T>& c, const Vec3<T>& rp, T k, Vec3<T>* axis_minus_pivot = nullptr,
+                           bool* relative = nullptr) {
+  if (relative) *relative = false;
   if (c.one_minus_cos >= T(2)) return Cap<T>{c.axis, T(2)};  // the whole sphere maps onto itself
   const Vec3<T>& wc = c.axis;
   // The plane through the origin, w_c and r_p (Fig. 3 (1)); any plane through w_c when r_p is parallel to it.
@@ -158,7 +168,8 @@ template <class T> Cap<T> pivot_transform_cap(const Cap<T>& c, const Vec3<T>& rp
   // of the cap around the bisector (diameter >= pi): no flip there.
   const T rn = rp.norm();
   const bool contains_pivot = rn > T(0) && (rp / rn - wc).squaredNorm() <= T(2) * omc;
-  const T d1 = pivot_offset(p1, rp).norm(), d2 = pivot_offset(p2, rp).norm();  // |p_i - r_p| for unit p_i
+  const Vec3<T> o1 = pivot_offset(p1, rp), o2 = pivot_offset(p2, rp);  // r_p - p_i for unit p_i
+  const T d1 = o1.norm(), d2 = o2.norm();
   const T d_min = contains_pivot ? T(1) - rn : std::min(d1, d2);
   const T alpha = T(2) * std::asin(std::min(T(1), std::sqrt(omc / T(2))));
   const bool surely_small = T(2) * alpha * k < kPi<T> / T(2) * d_min * d_min;
@@ -180,6 +191,18 @@ template <class T> Cap<T> pivot_transform_cap(const Cap<T>& c, const Vec3<T>& rp
   if (s < T(0.5)) {
     const T small = s * s / (T(1) + std::sqrt((T(1) - s) * (T(1) + s)));
     image_omc = axis.dot(g1) >= T(0) ? small : T(2) - small;
+    if (axis_minus_pivot && image_omc == small && sum.squaredNorm() >= diff.squaredNorm() && d1 > T(0) && d2 > T(0)) {
+      const Vec3<T> q1 = (k / (d1 * d1)) * o1, q2 = (k / (d2 * d2)) * o2;
+      const Vec3<T> h = (q1 + q2) / T(2), m = rp + h;
+      const T mn = m.norm();
+      const Vec3<T> off = h + m * ((q1 - q2).squaredNorm() / T(4) / (T(1) + mn) / mn);
+      const Vec3<T> a = rp + off;
+      if (all_finite(off) && a.norm() > T(0)) {
+        *axis_minus_pivot = off;
+        axis = a / a.norm();
+        if (relative) *relative = true;
+      }
+    }
   } else {
     image_omc = std::min(T(2), ((g1 - axis).squaredNorm() + (g2 - axis).squaredNorm()) / T(4));
   }
@@ -417,6 +440,10 @@ template <class T> struct SptdCapView {
   Sptd<T> sptd;
   T k = 0;
   Cap<T> cap, image;        // C and g(C)
+  // Uniform base with a small image: g(C)'s axis minus r_p (pivot_transform_cap); samples and densities are then
+  // formed from offsets to r_p, never from unit vectors near it.
+  bool image_relative = false;
+  Vec3<T> image_offset = Vec3<T>::Zero();
   CosineCapView<T> cosine;  // for the clamped-cosine base
   T base_integral = 0;      // integral of D_std over g(C) = integral of D over C (Eq. 10)
   bool valid() const { return reason == NoSample::kNone; }
@@ -437,7 +464,9 @@ template <class T> SptdCapView<T> make_sptd_cap_view(const SptdCapGeometry<T>& g
     return v.reason = NoSample::kBadNormal, v;
   v.k = pivot_k(v.sptd.pivot);
   if (!(v.k > T(0))) return v.reason = NoSample::kInvalidGeometry, v;
-  v.image = pivot_transform_cap(v.cap, v.sptd.pivot, v.k);
+  v.image = v.sptd.base == SptdBase::kUniform
+                ? pivot_transform_cap(v.cap, v.sptd.pivot, v.k, &v.image_offset, &v.image_relative)
+                : pivot_transform_cap(v.cap, v.sptd.pivot, v.k);
   if (!(v.image.one_minus_cos > T(0)) || !all_finite(v.image.axis)) return v.reason = NoSample::kTooSmall, v;
   if (v.sptd.base == SptdBase::kUniform) {
     v.base_integral = v.image.one_minus_cos / T(2);
@@ -478,7 +507,17 @@ template <class T> T pdf_sptd_cap(const SptdCapView<T>& v, const Vec3<T>& w) {
   const bool in_c = omc <= T(1) ? (wu - v.cap.axis).squaredNorm() <= T(2) * omc * (T(1) + T(8) * e) + T(16) * e * e
                                 : (wu + v.cap.axis).squaredNorm() >= T(2) * (T(2) - omc) * (T(1) - T(8) * e) - T(16) * e * e;
   if (!in_c) return T(0);
-  const T p = base_cap_pdf(v, pivot_transform(wu, v.sptd.pivot, v.k));
+  T p;
+  if (v.image_relative) {
+    // g(w) - r_p = k o / |o|^2, o = pivot_offset(w) (the anti-inversion form); g(w) - axis = that - image_offset.
+    const Vec3<T> o = pivot_offset(wu, v.sptd.pivot);
+    const T o2 = o.squaredNorm();
+    const Vec3<T> gi = o2 > T(0) ? Vec3<T>((v.k / o2) * o - v.image_offset) : Vec3<T>::Constant(T(2));
+    const T slack = T(8) * e;
+    p = gi.squaredNorm() <= T(2) * v.image.one_minus_cos * (T(1) + slack) ? T(1) / v.image.solid_angle() : T(0);
+  } else {
+    p = base_cap_pdf(v, pivot_transform(wu, v.sptd.pivot, v.k));
+  }
   // The product overflows for densities beyond T's range (a pivot within ~eps of the sphere, a tiny cap): no
   // density rather than Inf (found by fuzz_sptd_float, issue 7).
   const T pdf = p > T(0) ? p * pivot_jacobian(wu, v.sptd.pivot, v.k) : T(0);
@@ -487,10 +526,24 @@ template <class T> T pdf_sptd_cap(const SptdCapView<T>& v, const Vec3<T>& w) {
 
 template <class T> DirectionSample<T> sample_sptd_cap(const SptdCapView<T>& v, const Vec2<T>& u) {
   if (!v.valid()) return DirectionSample<T>::none(v.reason);
-  const Vec3<T> wi = v.sptd.base == SptdBase::kUniform ? sample_uniform_cap_direction(v.image, u)
-                                                       : sample_cosine_cap_direction(v.cosine, u);
   DirectionSample<T> s;
-  s.direction = pivot_transform(wi, v.sptd.pivot, v.k);  // Fig. 5 (4): w = g(w_i)
+  if (v.image_relative) {
+    // w_i - r_p = (axis - r_p) - axis (1 - cos) + sin (cos phi e_x + sin phi e_y) (Shirley's cone sampling as in
+    // sample_uniform_cap_direction), and w = g(w_i) = r_p - k q / |q|^2 for q = w_i - r_p (anti-inversion form).
+    const T omc = u[0] * v.image.one_minus_cos;
+    const T sin_t = std::sqrt(std::max(T(0), omc * (T(2) - omc)));
+    const T phi = kTwoPi<T> * u[1];
+    const Vec3<T> q = v.image_offset + Frame<T>::from_z(v.image.axis).to_world(
+                                           Vec3<T>(sin_t * std::cos(phi), sin_t * std::sin(phi), -omc));
+    const T q2 = q.squaredNorm();
+    if (!(q2 > T(0))) return DirectionSample<T>::none(NoSample::kOnSilhouette);
+    const Vec3<T> w = v.sptd.pivot - (v.k / q2) * q;
+    s.direction = w / w.norm();
+  } else {
+    const Vec3<T> wi = v.sptd.base == SptdBase::kUniform ? sample_uniform_cap_direction(v.image, u)
+                                                         : sample_cosine_cap_direction(v.cosine, u);
+    s.direction = pivot_transform(wi, v.sptd.pivot, v.k);  // Fig. 5 (4): w = g(w_i)
+  }
   s.pdf = pdf_sptd_cap(v, s.direction);
   if (!(s.pdf > T(0)) || !std::isfinite(s.pdf) || !all_finite(s.direction))
     return DirectionSample<T>::none(NoSample::kOnSilhouette);
