@@ -375,11 +375,16 @@ template <class T> T sptd_uniform_two_cap_integral(const Vec3<T>& rp, const Cap<
 // ---- Sampling D_std over a cap -----------------------------------------------------------------------------
 
 // Uniform over a cap (Shirley 1996 cone sampling, as in sphere.h): 1 - cos = u0 (1 - cos(psi)).
-template <class T> Vec3<T> sample_uniform_cap_direction(const Cap<T>& c, const Vec2<T>& u) {
-  const T omc = u[0] * std::min(T(2), c.one_minus_cos);
+// The sample minus the cap's axis, in the axis' frame: (sin cos phi, sin sin phi, -(1 - cos)).
+template <class T> Vec3<T> uniform_cap_offset_local(T cap_one_minus_cos, const Vec2<T>& u) {
+  const T omc = u[0] * std::min(T(2), cap_one_minus_cos);
   const T sin_t = std::sqrt(std::max(T(0), omc * (T(2) - omc)));
   const T phi = kTwoPi<T> * u[1];
-  const Vec3<T> w = Frame<T>::from_z(c.axis).to_world(Vec3<T>(sin_t * std::cos(phi), sin_t * std::sin(phi), T(1) - omc));
+  return Vec3<T>(sin_t * std::cos(phi), sin_t * std::sin(phi), -omc);
+}
+template <class T> Vec3<T> sample_uniform_cap_direction(const Cap<T>& c, const Vec2<T>& u) {
+  const Vec3<T> w =
+      Frame<T>::from_z(c.axis).to_world(Vec3<T>(uniform_cap_offset_local(c.one_minus_cos, u) + Vec3<T>(0, 0, 1)));
   return w / w.norm();
 }
 
@@ -482,11 +487,15 @@ template <class T> SptdCapView<T> make_sptd_cap_view(const SptdCapGeometry<T>& g
 }
 
 // Density of the original distribution restricted to g(C), normalised, at w_i.
-template <class T> T base_cap_pdf(const SptdCapView<T>& v, const Vec3<T>& wi) {
-  // Membership with a relative slack of 8 eps on the chord: a sample generated inside g(C) must test inside
-  // after the pivot round trip (two roundings).
+// Membership in g(C) by the squared chord from its axis, with a relative slack of 8 eps: a sample generated inside
+// g(C) must test inside after the pivot round trip (two roundings).
+template <class T> bool within_image(const SptdCapView<T>& v, T chord2_to_axis) {
   const T slack = T(8) * std::numeric_limits<T>::epsilon();
-  if (!((wi - v.image.axis).squaredNorm() <= T(2) * v.image.one_minus_cos * (T(1) + slack))) return T(0);
+  return chord2_to_axis <= T(2) * v.image.one_minus_cos * (T(1) + slack);
+}
+
+template <class T> T base_cap_pdf(const SptdCapView<T>& v, const Vec3<T>& wi) {
+  if (!within_image(v, (wi - v.image.axis).squaredNorm())) return T(0);
   if (v.sptd.base == SptdBase::kUniform) return T(1) / v.image.solid_angle();
   const T c = wi.dot(v.sptd.base_axis);
   return c > T(0) ? c / v.cosine.area : T(0);
@@ -512,9 +521,9 @@ template <class T> T pdf_sptd_cap(const SptdCapView<T>& v, const Vec3<T>& w) {
     // g(w) - r_p = k o / |o|^2, o = pivot_offset(w) (the anti-inversion form); g(w) - axis = that - image_offset.
     const Vec3<T> o = pivot_offset(wu, v.sptd.pivot);
     const T o2 = o.squaredNorm();
-    const Vec3<T> gi = o2 > T(0) ? Vec3<T>((v.k / o2) * o - v.image_offset) : Vec3<T>::Constant(T(2));
-    const T slack = T(8) * e;
-    p = gi.squaredNorm() <= T(2) * v.image.one_minus_cos * (T(1) + slack) ? T(1) / v.image.solid_angle() : T(0);
+    p = o2 > T(0) && within_image(v, Vec3<T>((v.k / o2) * o - v.image_offset).squaredNorm())
+            ? T(1) / v.image.solid_angle()
+            : T(0);
   } else {
     p = base_cap_pdf(v, pivot_transform(wu, v.sptd.pivot, v.k));
   }
@@ -530,11 +539,8 @@ template <class T> DirectionSample<T> sample_sptd_cap(const SptdCapView<T>& v, c
   if (v.image_relative) {
     // w_i - r_p = (axis - r_p) - axis (1 - cos) + sin (cos phi e_x + sin phi e_y) (Shirley's cone sampling as in
     // sample_uniform_cap_direction), and w = g(w_i) = r_p - k q / |q|^2 for q = w_i - r_p (anti-inversion form).
-    const T omc = u[0] * v.image.one_minus_cos;
-    const T sin_t = std::sqrt(std::max(T(0), omc * (T(2) - omc)));
-    const T phi = kTwoPi<T> * u[1];
-    const Vec3<T> q = v.image_offset + Frame<T>::from_z(v.image.axis).to_world(
-                                           Vec3<T>(sin_t * std::cos(phi), sin_t * std::sin(phi), -omc));
+    const Vec3<T> q =
+        v.image_offset + Frame<T>::from_z(v.image.axis).to_world(uniform_cap_offset_local(v.image.one_minus_cos, u));
     const T q2 = q.squaredNorm();
     if (!(q2 > T(0))) return DirectionSample<T>::none(NoSample::kOnSilhouette);
     const Vec3<T> w = v.sptd.pivot - (v.k / q2) * q;
