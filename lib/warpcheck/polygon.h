@@ -167,8 +167,20 @@ NoSample check_polygon(const PolygonLight<T>& p, std::string* message = nullptr,
     const Vec3<T> b = p.vertices[(i + 1) % p.count] - p.vertices[i];
     const T s = nhat.dot(kahan_cross<T>(a, b)), c = a.dot(b);
     const T err_a = rounding(i - 1) + rounding(i), err_b = rounding(i) + rounding(i + 1);
-    if (s < -(a.norm() * err_b + b.norm() * err_a + err_a * err_b))
-      return fail(NoSample::kInvalidGeometry, "polygon is not convex");
+    const T s_err = a.norm() * err_b + b.norm() * err_a + err_a * err_b;
+    if (s < -s_err) return fail(NoSample::kInvalidGeometry, "polygon is not convex");
+    // A spike: b runs back along a, the computed turn atan2(s, c) is within rounding of +-pi, and which of the two
+    // it is depends on the sign of a rounding error in s (the kernels' edge planes use the exact differences a and
+    // b, and s from kahan_cross is accurate to a few eps |a| |b|). The turning sum can still come to one
+    // revolution and the reflex turn next to it can be within the vertices' rounding (an edge an ulp long), so the
+    // spike passed as convex, and the plane through the reversed edge faced outwards in every kernel (found by
+    // fuzz_polygon_projected_double da03856c... and fuzz_polygon_solid_angle_double 3091f781..., issue 7). No
+    // convex polygon turns by pi (an interior angle of 0). Not measured against the vertices' rounding: a short
+    // edge after a long one is exact (Sterbenz) and turns by what it says (a collinear vertex an ulp before a
+    // corner turns by 3 pi / 4 with |s| = |c| = eps), and M^-1 P under an ill-conditioned M (ltc.h) is a
+    // legitimate needle whose ends turn by pi - 1e-8.
+    if (c < T(0) && std::abs(s) <= T(8) * eps * a.norm() * b.norm())
+      return fail(NoSample::kInvalidGeometry, "polygon is not convex (a spike)");
     turning += std::atan2(s, c);
   }
   if (std::abs(turning - kTwoPi<T>) > T(0.5)) return fail(NoSample::kInvalidGeometry, "polygon is not simple");
@@ -246,6 +258,18 @@ PolygonView<T> make_polygon_view(const PolygonLightGeometry<T>& g, T vertex_roun
     reach = std::max(reach, Vec3<T>(g.light.vertices[i] - g.shading.position).cwiseAbs().maxCoeff());
   if (!(std::abs(v.plane_distance) > T(8) * std::numeric_limits<T>::epsilon() * reach))
     return v.reason = NoSample::kEdgeOn, v;
+  // Within the light's non-planarity: check_polygon accepts vertices up to its planarity tolerance off the plane,
+  // and a shading point closer to the plane than that can have vertices on both sides. The light seen from it is
+  // then no convex spherical polygon (its edges wind both ways), and which side x is on is undetermined, as
+  // above: edge-on. A vertex counts as on the other side only beyond its own rounding (vertex_rounding
+  // |V_k|_inf, which for ltc.h's M^-1 P includes cond(M)) plus the offset's 8 eps reach. (Found by
+  // fuzz_polygon_projected_double fe6b6d80... and fuzz_polygon_solid_angle_double 5c7b9846..., issue 7.)
+  for (int i = 0; i < g.light.count; ++i) {
+    const T side = v.plane_normal.dot(Vec3<T>(g.light.vertices[i] - g.shading.position));
+    const T err = vertex_rounding * g.light.vertices[i].cwiseAbs().maxCoeff() +
+                  T(8) * std::numeric_limits<T>::epsilon() * reach;
+    if ((v.plane_distance > T(0) ? -side : side) > err) return v.reason = NoSample::kEdgeOn, v;
+  }
   v.local.count = g.light.count;
   for (int i = 0; i < g.light.count; ++i) {
     Vec3<T> l = v.frame.to_local(Vec3<T>(g.light.vertices[i] - g.shading.position));

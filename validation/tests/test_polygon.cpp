@@ -581,6 +581,44 @@ TYPED_TEST(PolygonKernels, AReflexNotchBehindAShortEdgeIsNotConvexButACollinearV
   }
 }
 
+// A spike: an edge that runs back along the previous one. Triangle (0,0), (1,0), (0,1) with an extra vertex an ulp
+// before (1,0) on the first edge, so the edge (1,0) -> (1 - eps, 0) turns back by pi: its turn atan2(+0, c < 0)
+// counts as +pi, the reflex turn after it is within the vertices' rounding, and the turns still add up to one
+// revolution. Every kernel's plane through that edge then faces outwards (fuzz_polygon_projected_double
+// da03856c..., fuzz_polygon_solid_angle_double 3091f781..., issue 7). Without the spike test check_polygon passed it.
+TYPED_TEST(PolygonKernels, ASpikeIsNotConvex) {
+  using T = TypeParam;
+  const T eps = std::numeric_limits<T>::epsilon();
+  std::string message;
+  const PolygonLight<T> spike{Vec3<T>(0, 0, 1), Vec3<T>(1, 0, 1), Vec3<T>(1 - eps, 0, 1), Vec3<T>(0, 1, 1)};
+  EXPECT_EQ(check_polygon(spike, &message), NoSample::kInvalidGeometry);
+  EXPECT_NE(message.find("spike"), std::string::npos) << message;
+  for (NoSample r : all_reasons(geom<T>(Vec3<T>(T(0.2), T(0.2), 0), Vec3<T>(0, 0, 1), spike)))
+    EXPECT_EQ(r, NoSample::kInvalidGeometry) << to_string(r);
+  // The same vertex an ulp forward on the edge is a collinear vertex, not a spike: valid.
+  const PolygonLight<T> collinear{Vec3<T>(0, 0, 1), Vec3<T>(1 - eps, 0, 1), Vec3<T>(1, 0, 1), Vec3<T>(0, 1, 1)};
+  EXPECT_EQ(check_polygon(collinear, &message), NoSample::kNone) << message;
+}
+
+// check_polygon accepts vertices off the light's plane up to its planarity tolerance (about 8 sqrt(eps) of the
+// width). A shading point closer to the plane than that, with vertices on both sides of it, does not see a
+// convex spherical polygon, and which side of the light it is on is undetermined: edge-on (fuzz_polygon_projected_double
+// fe6b6d80..., fuzz_polygon_solid_angle_double 5c7b9846..., issue 7). A unit square with one corner lifted by
+// h = sqrt(eps), within the tolerance; the centroid's plane is near z = h / 4.
+TYPED_TEST(PolygonKernels, AShadingPointWithinTheLightsNonPlanarityWithVerticesOnBothSidesSeesItEdgeOn) {
+  using T = TypeParam;
+  const T h = std::sqrt(std::numeric_limits<T>::epsilon());
+  const PolygonLight<T> warped{Vec3<T>(0, 0, 0), Vec3<T>(1, 0, 0), Vec3<T>(1, 1, h), Vec3<T>(0, 1, 0)};
+  ASSERT_EQ(check_polygon(warped), NoSample::kNone);
+  const Vec3<T> down(0, 0, -1);
+  // x at z = 3h/8: the lifted corner above it, the other three below.
+  for (NoSample r : all_reasons(geom<T>(Vec3<T>(T(0.5), T(0.5), T(0.375) * h), down, warped)))
+    EXPECT_EQ(r, NoSample::kEdgeOn) << to_string(r);
+  // x at z = 2h, above every vertex: a light below it, sampled.
+  for (NoSample r : all_reasons(geom<T>(Vec3<T>(T(0.5), T(0.5), 2 * h), down, warped)))
+    EXPECT_EQ(r, NoSample::kNone) << to_string(r);
+}
+
 // Sec. 3.1 / Fig. 3b: the sectors cover the whole light when an edge of sign 0 lies inside a chain. A triangle
 // with a collinear extra vertex (a doubled vertex 2.2e-16 away, on the same vertical line as the clip point), cut
 // by the horizon: the inner chain used to stop at that edge, A_Sigma 9.3e-22 instead of 1.57e-4 (fuzz_ltc_double
