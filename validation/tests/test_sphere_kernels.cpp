@@ -48,13 +48,13 @@ TYPED_TEST(SphereKernels, DegenerateGeometryGivesNoSampleWithAReasonNeverNaN) {
   }
 }
 
-TYPED_TEST(SphereKernels, SamplesAreUnitDirectionsInsideTheConeWithMatchingPdf) {
-  using T = TypeParam;
+// Both kernels on one geometry: 2000 samples are unit directions inside the cone whose pdf matches pdf(direction).
+template <class T> void expect_unit_directions_inside_the_cone_with_matching_pdf(const SphereLightGeometry<T>& g) {
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> U(0, 1);
-  const auto g = geometry<T>(Vec3<T>(0.1, -0.2, 0), Vec3<T>(0, 0.3, 1), Vec3<T>(1, 2, 2.5), T(0.7));
   const auto view = make_sphere_view(g);
   ASSERT_TRUE(view.valid());
+  int valid = 0;
   const T tol = T(64) * std::numeric_limits<T>::epsilon();
   for (int i = 0; i < 2000; ++i) {
     const Vec2<T> u(T(U(rng)), T(U(rng)));
@@ -79,8 +79,26 @@ TYPED_TEST(SphereKernels, SamplesAreUnitDirectionsInsideTheConeWithMatchingPdf) 
         kappa = d_over_r * q / std::max(T(1) - q * q, std::numeric_limits<T>::min());
       }
       EXPECT_LE(std::abs(pdf / s.pdf - T(1)), tol * (T(1) + kappa)) << "kernel " << kernel << " u0 " << double(u[0]);
+      ++valid;
     }
   }
+  EXPECT_EQ(valid, 4000);
+}
+
+TYPED_TEST(SphereKernels, SamplesAreUnitDirectionsInsideTheConeWithMatchingPdf) {
+  using T = TypeParam;
+  expect_unit_directions_inside_the_cone_with_matching_pdf(
+      geometry<T>(Vec3<T>(0.1, -0.2, 0), Vec3<T>(0, 0.3, 1), Vec3<T>(1, 2, 2.5), T(0.7)));
+}
+
+// A sphere 0.9 of the largest finite T away (d / r = 3): |p - x| of a sampled point rounds to Inf if it is formed
+// unscaled, and the visible-area sampler returned a zero direction (UBSan: division by zero in renormalized;
+// found by fuzz_sphere_float 62328c27..., d = 3.4e38, issue 7).
+TYPED_TEST(SphereKernels, SamplesOfASphereNearTheLargestFiniteDistanceAreUnitDirectionsWithMatchingPdf) {
+  using T = TypeParam;
+  const T m = std::numeric_limits<T>::max();
+  expect_unit_directions_inside_the_cone_with_matching_pdf(
+      geometry<T>(Vec3<T>(T(-0.45) * m, 0, 0), Vec3<T>(1, 0, 0), Vec3<T>(T(0.45) * m, 0, 0), T(0.3) * m));
 }
 
 }  // namespace
