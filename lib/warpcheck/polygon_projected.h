@@ -106,7 +106,14 @@ template <class T> void edge_boundary_point(const EdgeEllipse<T>& e, const Vec3<
     // (found by fuzz_polygon_projected_double: u_0 = 0 picked a zero-width sector of area 8e-21 next to such an
     // edge, sample 0.75 rad outside an ordinary triangle, issue 7). We take its midpoint.
     const T t = den != T(0) ? std::clamp(ca / den, T(0), T(1)) : T(0.5);
-    const Vec3<T> p = a + t * (b - a);
+    Vec3<T> p = a + t * (b - a);
+    // The point must lie on the ray, not behind it. An edge whose great circle passes near the zenith and whose
+    // ends lie at nearly opposite azimuths is nearly collinear with the ray's line; at w on one end's azimuth
+    // (u_0 = 0 gives w = s0 exactly) ca and cb are both rounding noise, and t could pick the far end behind the
+    // ray: r^2 of a horizon vertex instead of the near vertex's (found by fuzz_polygon_projected_double
+    // 07bc462c...: sample 0.74 rad outside a triangle, issue 7). The endpoint ahead along w is then the point.
+    const Vec2<T> pxy(p.x(), p.y());
+    if (pxy.dot(w) < T(0)) p = Vec2<T>(a.x(), a.y()).dot(w) >= Vec2<T>(b.x(), b.y()).dot(w) ? a : b;
     const T m = p.cwiseAbs().maxCoeff();
     if (m > T(0) && std::isfinite(m)) {
       const Vec3<T> q = p / m;

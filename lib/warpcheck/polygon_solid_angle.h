@@ -26,7 +26,11 @@ template <class T> struct PolygonFanView {
   // light's own edge planes (from V_j - x) and the horizon, never planes through two clip points, whose
   // normal is undetermined when the clip points (nearly) coincide (found by fuzz_polygon_solid_angle_double:
   // pdf 0 for a sample 2e-10 rad inside the clipped polygon).
-  std::array<Vec3<T>, kMaxClippedVertices> inward{};
+  // Both also have the plane through x parallel to the light's (its far side): the edge planes all pass through x,
+  // so near a sliver's vertex they hold its antipode too, up to a margin of the sliver's width that rounds to 0
+  // (found by fuzz_polygon_solid_angle_double de04c20e...: a hexagon 8 long and 1.4e-9 wide, pdf 9e18 at the
+  // antipode of a vertex's direction, issue 7).
+  std::array<Vec3<T>, kMaxFanVertices> inward{};
   int planes = 0;
   Vec3<T> plane_normal = Vec3<T>::Zero();             // unit
   T plane_distance = 0;                               // |plane_normal . p_0| > 0
@@ -36,9 +40,12 @@ template <class T> struct PolygonFanView {
 // u_b - u_a for u = p / |p|, from the edge e = p_b - p_a without cancellation:
 // u_b - u_a = (e |p_a| - p_a (|p_b| - |p_a|)) / (|p_a| |p_b|), |p_b| - |p_a| = e.(p_a + p_b) / (|p_a| + |p_b|).
 template <class T> Vec3<T> unit_difference(const Vec3<T>& pa, const Vec3<T>& pb, const Vec3<T>& e) {
-  const T na = pa.norm(), nb = pb.norm();
-  const T dn = e.dot(Vec3<T>(pa + pb)) / (na + nb);
-  return (e * na - pa * dn) / (na * nb);
+  // Grouped as (e - u_a (|p_b| - |p_a|)) / |p_b| with the dot product taken against (p_a + p_b) / (|p_a| + |p_b|):
+  // no product of two lengths, which underflows for a light ~1e-160 from x (UBSan: division by zero, found by
+  // fuzz_polygon_solid_angle_double 0f46b33f..., issue 7).
+  const T na = pa.stableNorm(), nb = pb.stableNorm();  // norm() squares, and underflows to 0 for |p| < 1e-154
+  const T dn = e.dot(Vec3<T>((pa + pb) / (na + nb)));
+  return (e - (pa / na) * dn) / nb;
 }
 
 template <class T> PolygonFanView<T> make_polygon_fan_view(const PolygonLightGeometry<T>& g, bool clipped) {
@@ -112,14 +119,16 @@ template <class T> PolygonFanView<T> make_polygon_fan_view(const PolygonLightGeo
       const int a = reverse ? (m - j) % m : j, b = reverse ? (m - j - 1 + m) % m : (j + 1) % m;
       f.inward[j] = kahan_cross(f.p[j], Vec3<T>(g.light.vertices[b] - g.light.vertices[a]));
     }
+    f.inward[f.planes++] = reverse ? Vec3<T>(-pv.plane_normal) : pv.plane_normal;
   } else {
     const int m = g.light.count;
     const T orient = reverse ? T(-1) : T(1);
     for (int j = 0; j < m; ++j)
       f.inward[j] = orient * kahan_cross(Vec3<T>(g.light.vertices[j] - g.shading.position),
                                          Vec3<T>(g.light.vertices[(j + 1) % m] - g.light.vertices[j]));
-    f.inward[m] = pv.normal;  // m <= kMaxPolygonVertices = kMaxClippedVertices - 1
-    f.planes = m + 1;
+    f.inward[m] = pv.normal;  // m <= kMaxPolygonVertices = kMaxFanVertices - 2
+    f.inward[m + 1] = orient * pv.plane_normal;
+    f.planes = m + 2;
   }
   return f;
 }
@@ -151,9 +160,17 @@ template <class T> PolygonSolidAngleView<T> make_polygon_solid_angle_view(const 
   if (!v.fan.valid()) return v.reason = v.fan.reason, v;
   const auto& f = v.fan;
   for (int k = 1; k + 1 < f.count; ++k) {
-    const T det = f.p[0].dot(kahan_cross(f.e[k], f.e[k + 1]));
-    v.g0[k] = det / (f.p[0].norm() * f.p[k].norm() * f.p[k + 1].norm());
-    const T denom = T(1) + f.u[0].dot(f.u[k]) + f.u[0].dot(f.u[k + 1]) + f.u[k].dot(f.u[k + 1]);
+    // As u_0 . ((e_k / |p_k|) x (e_{k+1} / |p_{k+1}|)): each factor scaled before the product, because
+    // |p_0| |p_k| |p_{k+1}| underflows to 0 for a light ~1e-110 from x (UBSan: division by zero, found by
+    // fuzz_polygon_solid_angle_double 0f46b33f..., issue 7), and the scaled edges have the size of the light's
+    // angular extent.
+    v.g0[k] = f.u[0].dot(kahan_cross(Vec3<T>(f.e[k] / f.p[k].stableNorm()), Vec3<T>(f.e[k + 1] / f.p[k + 1].stableNorm())));
+    // 1 + u0.uk + u0.uk1 + uk.uk1 = |u0 + uk|^2 / 2 + uk1 . (u0 + uk): 1 + u0.uk cancels for nearly antipodal u0, uk
+    // (x next to the light's edge 0k or diagonal), while |u0 + uk|^2 / 2 keeps its relative precision down to
+    // |u0 + uk| ~ eps (found by fuzz_polygon_solid_angle_double 7739f49d...: x 7e-10 from an edge's midpoint,
+    // 1 + u0.u1 = 2.4e-19 computed as rounding noise, sample 1 rad outside, issue 7).
+    const Vec3<T> sum = f.u[0] + f.u[k];
+    const T denom = sum.squaredNorm() / T(2) + f.u[k + 1].dot(sum);
     v.area[k] = std::max(T(0), T(2) * std::atan2(v.g0[k], denom));
     v.solid_angle += v.area[k];
   }
@@ -228,11 +245,12 @@ template <class T> DirectionSample<T> sample_polygon_solid_angle(const PolygonSo
   const int k = pick_fan_triangle(v.area, f.count, u[0] * v.solid_angle, &a);
   if (k < 0) return DirectionSample<T>::none(NoSample::kTooSmall);
   const Vec3<T>&v0 = f.u[0], &v1 = f.u[k], &v2 = f.u[k + 1];
-  const T g0 = v.g0[k], g1 = v0.dot(v2) + v1.dot(v2), g2 = T(1) + v0.dot(v1);
+  const T g0 = v.g0[k], g1 = v0.dot(v2) + v1.dot(v2), g2 = (v0 + v1).squaredNorm() / T(2);  // g2 = 1 + v0.v1, as above
   const T c = std::cos(a / 2), s = std::sin(a / 2);
   const Vec3<T> r = (g0 * c - g1 * s) * v0 + (g2 * s) * v2;
   const T r2 = r.squaredNorm();
-  const Vec3<T> v2_x_v0 = kahan_cross(f.e[k + 1], f.p[0]) / (f.p[k + 1].norm() * f.p[0].norm());
+  // Scaled before the product, as G0 in make_polygon_solid_angle_view (|p_2| |p_0| underflows for tiny p).
+  const Vec3<T> v2_x_v0 = kahan_cross(Vec3<T>(f.e[k + 1] / f.p[k + 1].stableNorm()), v0);
   const Vec3<T> offset = r2 > T(0) ? Vec3<T>((T(2) * g2 * s / r2) * kahan_cross(r, v2_x_v0)) : Vec3<T>::Zero();
   // d = v2' - v1 = (v0 - v1) + offset, with v0 - v1 from the edge e_k.
   const Vec3<T> d = -unit_difference(f.p[0], f.p[k], f.e[k]) + offset;
