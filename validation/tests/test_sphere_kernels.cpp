@@ -91,9 +91,10 @@ TYPED_TEST(SphereKernels, SamplesAreUnitDirectionsInsideTheConeWithMatchingPdf) 
       geometry<T>(Vec3<T>(0.1, -0.2, 0), Vec3<T>(0, 0.3, 1), Vec3<T>(1, 2, 2.5), T(0.7)));
 }
 
-// A sphere 0.9 of the largest finite T away (d / r = 3): |p - x| of a sampled point rounds to Inf if it is formed
-// unscaled, and the visible-area sampler returned a zero direction (UBSan: division by zero in renormalized;
-// found by fuzz_sphere_float 62328c27..., d = 3.4e38, issue 7).
+// A sphere 0.9 of the largest finite T away (d / r = 3). fuzz_sphere_float 62328c27... (d = 3.4e38: a zero direction,
+// UBSan division by zero in renormalized; issue 7) was lost with its machine before it was kept; sphere.h now forms
+// the sampled point relative to d. This geometry passes on the old kernel too: it states the property, it does not
+// reproduce that input.
 TYPED_TEST(SphereKernels, SamplesOfASphereNearTheLargestFiniteDistanceAreUnitDirectionsWithMatchingPdf) {
   using T = TypeParam;
   const T m = std::numeric_limits<T>::max();
