@@ -112,8 +112,11 @@ template <class T> void edge_boundary_point(const EdgeEllipse<T>& e, const Vec3<
     // (u_0 = 0 gives w = s0 exactly) ca and cb are both rounding noise, and t could pick the far end behind the
     // ray: r^2 of a horizon vertex instead of the near vertex's (found by fuzz_polygon_projected_double
     // 07bc462c...: sample 0.74 rad outside a triangle, issue 7). The endpoint ahead along w is then the point.
-    const Vec2<T> pxy(p.x(), p.y());
-    if (pxy.dot(w) < T(0)) p = Vec2<T>(a.x(), a.y()).dot(w) >= Vec2<T>(b.x(), b.y()).dot(w) ? a : b;
+    // Behind by more than rounding only: an edge through the zenith meets every ray at p ~ 0, where the sign of
+    // p . w is noise (44e37d33...: the endpoint put a sample 0.36 rad outside).
+    const Vec2<T> axy(a.x(), a.y()), bxy(b.x(), b.y()), pxy(p.x(), p.y());
+    const T behind = T(8) * std::numeric_limits<T>::epsilon() * (axy.norm() + bxy.norm()) * w.norm();
+    if (pxy.dot(w) < -behind) p = axy.dot(w) >= bxy.dot(w) ? a : b;
     const T m = p.cwiseAbs().maxCoeff();
     if (m > T(0) && std::isfinite(m)) {
       const Vec3<T> q = p / m;

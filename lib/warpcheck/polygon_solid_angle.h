@@ -143,7 +143,7 @@ template <class T> bool in_fan_cone(const PolygonFanView<T>& f, const Vec3<T>& w
 
 template <class T> struct PolygonSolidAngleView {
   PolygonFanView<T> fan;
-  std::array<T, kMaxFanVertices> g0{}, area{};  // per fan triangle (0, k, k+1), stored at index k
+  std::array<T, kMaxFanVertices> g0{}, g1{}, g2{}, area{};  // per fan triangle (0, k, k+1), stored at index k
   T solid_angle = 0;
   NoSample reason = NoSample::kNone;
   bool valid() const { return reason == NoSample::kNone; }
@@ -165,12 +165,18 @@ template <class T> PolygonSolidAngleView<T> make_polygon_solid_angle_view(const 
     // fuzz_polygon_solid_angle_double 0f46b33f..., issue 7), and the scaled edges have the size of the light's
     // angular extent.
     v.g0[k] = f.u[0].dot(kahan_cross(Vec3<T>(f.e[k] / f.p[k].stableNorm()), Vec3<T>(f.e[k + 1] / f.p[k + 1].stableNorm())));
-    // 1 + u0.uk + u0.uk1 + uk.uk1 = |u0 + uk|^2 / 2 + uk1 . (u0 + uk): 1 + u0.uk cancels for nearly antipodal u0, uk
-    // (x next to the light's edge 0k or diagonal), while |u0 + uk|^2 / 2 keeps its relative precision down to
-    // |u0 + uk| ~ eps (found by fuzz_polygon_solid_angle_double 7739f49d...: x 7e-10 from an edge's midpoint,
-    // 1 + u0.u1 = 2.4e-19 computed as rounding noise, sample 1 rad outside, issue 7).
+    // Eq. 13's denominator 1 + u0.uk + u0.uk1 + uk.uk1 = G2 + G1 with G2 = 1 + u0.uk, G1 = uk1 . (u0 + uk), stored
+    // for the sampler, which must use the same values as the area (an area from one rounding and a sample from
+    // another put the sample past the triangle's far edge: 8.9e-8 rad outside a thin fan triangle, found by
+    // fuzz_polygon_solid_angle_double 8ad0e6a8..., issue 7). G2 = 1 + u0.uk cancels for nearly antipodal u0, uk
+    // (x next to the edge or diagonal 0k); there |u0 + uk|^2 / 2 keeps its relative precision down to
+    // |u0 + uk| ~ eps (found by 7739f49d...: x 7e-10 from an edge's midpoint, 1 + u0.u1 = 2.4e-19 computed as
+    // rounding noise, sample 1 rad outside).
     const Vec3<T> sum = f.u[0] + f.u[k];
-    const T denom = sum.squaredNorm() / T(2) + f.u[k + 1].dot(sum);
+    const T dot = f.u[0].dot(f.u[k]);
+    v.g2[k] = dot < T(0) ? sum.squaredNorm() / T(2) : T(1) + dot;
+    v.g1[k] = f.u[k + 1].dot(sum);
+    const T denom = v.g1[k] + v.g2[k];
     v.area[k] = std::max(T(0), T(2) * std::atan2(v.g0[k], denom));
     v.solid_angle += v.area[k];
   }
@@ -245,7 +251,7 @@ template <class T> DirectionSample<T> sample_polygon_solid_angle(const PolygonSo
   const int k = pick_fan_triangle(v.area, f.count, u[0] * v.solid_angle, &a);
   if (k < 0) return DirectionSample<T>::none(NoSample::kTooSmall);
   const Vec3<T>&v0 = f.u[0], &v1 = f.u[k], &v2 = f.u[k + 1];
-  const T g0 = v.g0[k], g1 = v0.dot(v2) + v1.dot(v2), g2 = (v0 + v1).squaredNorm() / T(2);  // g2 = 1 + v0.v1, as above
+  const T g0 = v.g0[k], g1 = v.g1[k], g2 = v.g2[k];  // as for the area (make_polygon_solid_angle_view)
   const T c = std::cos(a / 2), s = std::sin(a / 2);
   const Vec3<T> r = (g0 * c - g1 * s) * v0 + (g2 * s) * v2;
   const T r2 = r.squaredNorm();
