@@ -128,6 +128,13 @@ NoSample check_polygon(const PolygonLight<T>& p, std::string* message = nullptr,
   for (int i = 0; i < p.count; ++i)
     if (p.vertices[i] == p.vertices[(i + 1) % p.count])
       return fail(NoSample::kInvalidGeometry, "two consecutive vertices coincide");
+  // A vertex visited twice: no convex polygon does that, and the turning test can pass it when the loop between
+  // the visits has zero area (found by fuzz_polygon_solid_angle_double 804609b5...: (-4, 0, 0) as vertices 1 and 4
+  // of 7, sample 0.52 rad outside, issue 7).
+  for (int i = 0; i < p.count; ++i)
+    for (int j = i + 2; j < p.count; ++j)
+      if (p.vertices[i] == p.vertices[j] && !(i == 0 && j == p.count - 1))
+        return fail(NoSample::kInvalidGeometry, "a vertex repeats");
   const Vec3<T> area2 = polygon_area_vector(p);
   const T area2_norm = area2.norm();
   if (!(area2_norm > T(0)) || !std::isfinite(area2_norm)) return fail(NoSample::kZeroSize, "zero area");

@@ -75,6 +75,8 @@ TYPED_TEST(PolygonKernels, InvalidGeometryIsRejectedWithAReasonAndAMessage) {
       {PolygonLight<T>{Vec3<T>(0, 0, 1), Vec3<T>(1, 0, 1)}, NoSample::kInvalidGeometry, "at least 3"},
       {PolygonLight<T>{Vec3<T>(0, 0, 1), Vec3<T>(1, 0, 1), Vec3<T>(1, 1, 1), Vec3<T>(0.9, 0.2, 1)},
        NoSample::kInvalidGeometry, "not convex"},
+      {PolygonLight<T>{Vec3<T>(0, 0, 1), Vec3<T>(1, 0, 1), Vec3<T>(2, 0, 1), Vec3<T>(1, 0, 1), Vec3<T>(1, 1, 1)},
+       NoSample::kInvalidGeometry, "a vertex repeats"},
       {PolygonLight<T>{Vec3<T>(0, 0, 1), Vec3<T>(1, 0, 1), Vec3<T>(1, 1, 1.2), Vec3<T>(0, 1, 1)},
        NoSample::kInvalidGeometry, "not coplanar"},
       {PolygonLight<T>{Vec3<T>(1, 0, 1), Vec3<T>(-0.809, 0.588, 1), Vec3<T>(0.309, -0.951, 1),
