@@ -364,8 +364,15 @@ inline int reference_clipped_local(const PolygonLightGeometry<long double>& g, V
   for (int i = 0; i < m; ++i) {
     const Vec3<L>& a = loc[i];
     const Vec3<L>& b = loc[(i + 1) % m];
-    if (a.z() >= 0) out[k++] = a;
+    // A polygon that is convex in T up to rounding may cross the horizon more than twice in long double; the
+    // output has room for kMaxClippedVertices, and a longer result is no convex clipped polygon: 0 (found by
+    // fuzz_ltc_double 34d22625...: ASan stack-buffer-overflow here, issue 7).
+    if (a.z() >= 0) {
+      if (k >= kMaxClippedVertices) return 0;
+      out[k++] = a;
+    }
     if ((a.z() > 0 && b.z() < 0) || (a.z() < 0 && b.z() > 0)) {
+      if (k >= kMaxClippedVertices) return 0;
       const L t = a.z() / (a.z() - b.z());
       Vec3<L> c = a + t * (b - a);
       c.z() = 0;
