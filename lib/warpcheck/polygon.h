@@ -285,12 +285,6 @@ PolygonView<T> make_polygon_view(const PolygonLightGeometry<T>& g, T vertex_roun
     // normal made of rounding noise (found by fuzz_polygon_projected_double: samples up to 0.58 rad outside a
     // polygon touching the horizon, issue 7).
     if (std::abs(l.z()) <= T(8) * std::numeric_limits<T>::epsilon() * l.cwiseAbs().maxCoeff()) l.z() = T(0);
-    // Likewise a vertex within rounding of the zenith is at it: its azimuth is then rounding noise, and a
-    // subnormal xy (x a subnormal away from the vertex's vertical) has too few digits for the sectors' cross
-    // products (found by fuzz_ltc_double 156dd709...: M = I, x = (-4.9e-324, 0, 0) under the vertex (0, -4, 0) with
-    // n = -y: A_Sigma 0.912 instead of 0.680, issue 7).
-    const T xy_rounding = T(8) * std::numeric_limits<T>::epsilon() * l.cwiseAbs().maxCoeff();
-    if (std::abs(l.x()) <= xy_rounding && std::abs(l.y()) <= xy_rounding) l.x() = l.y() = T(0);
     v.local.v[i] = l;
   }
   return v;
