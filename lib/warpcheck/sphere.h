@@ -117,29 +117,23 @@ template <class T> DirectionSample<T> sample_sphere_visible_area(const SphereVie
   if (!v.valid()) return DirectionSample<T>::none(v.reason);
   const T r = light.radius, d = v.distance;
   const T s = r / d;
-  // 1 - r/d as (d - r) / d: exact difference for a shading point near the sphere (Sterbenz), one rounding.
-  const T one_minus_s = (d - r) / d;
   // Uniform on the visible cap: 1 - cos(alpha) = u0 (1 - r/d), alpha measured at the centre from -axis.
-  const T one_minus_cos_a = u[0] * one_minus_s;
+  const T one_minus_cos_a = u[0] * (T(1) - s);
+  const T cos_a = T(1) - one_minus_cos_a;
   const T sin_a = std::sqrt(std::max(T(0), one_minus_cos_a * (T(2) - one_minus_cos_a)));
   const T phi = kTwoPi<T> * u[1];
-  // Point on the sphere relative to the shading point, in the view frame (z towards the centre), divided by d:
-  // (p - x) / d = z + s m, m = (sin_a cos phi, sin_a sin phi, -cos_a). Scaled by d, not formed as p - x: |p - x|
-  // rounds to Inf when d is near the largest finite T (found by fuzz_sphere_float 62328c27...: d = 3.4e38, a zero
-  // direction after dividing by Inf, issue 7).
-  // 1 - s cos_a = (1 - s) + s (1 - cos_a): a sum of two non-negative terms.
-  const Vec3<T> local(s * sin_a * std::cos(phi), s * sin_a * std::sin(phi), one_minus_s + s * one_minus_cos_a);
-  const T dist_over_d = local.norm();  // in [sqrt(1 - s^2), 1]: no overflow or underflow
-  // cos_light * dist = -m.(p - x) = d cos_a - r = (d - r)(1 - u0): exact algebra, no cancellation; over d:
-  // (1 - s)(1 - u0).
-  const T cos_light_times_dist_over_d = one_minus_s * (T(1) - u[0]);
-  if (!(cos_light_times_dist_over_d > T(0))) return DirectionSample<T>::none(NoSample::kOnSilhouette);
-  // pdf = dist^3 / (cos_light dist * 2 pi r^2 (1 - r/d)) = (dist/d / s)^2 (dist/d) / ((1 - s)(1 - u0) 2 pi (1 - s)),
-  // free of d, so that no intermediate overflows.
-  const T dist_over_r = dist_over_d / s;
+  // Point on the sphere relative to the shading point, in the view frame (z towards the centre):
+  // p - x = d z + r m, m = (sin_a cos phi, sin_a sin phi, -cos_a).
+  const Vec3<T> local(r * sin_a * std::cos(phi), r * sin_a * std::sin(phi), d - r * cos_a);
+  const T dist = local.stableNorm();
+  // cos_light * dist = -m.(p - x) = d cos_a - r = (d - r)(1 - u0): exact algebra, no cancellation.
+  const T cos_light_times_dist = (d - r) * (T(1) - u[0]);
+  if (!(cos_light_times_dist > T(0))) return DirectionSample<T>::none(NoSample::kOnSilhouette);
+  // pdf = dist^3 / (cos_light dist * 2 pi r^2 (1 - r/d)), grouped so that no intermediate overflows.
+  const T dist_over_r = dist / r;
   DirectionSample<T> out;
-  out.direction = renormalized(v.frame.to_world(local / dist_over_d));
-  out.pdf = dist_over_r * dist_over_r * (dist_over_d / cos_light_times_dist_over_d) / (kTwoPi<T> * one_minus_s);
+  out.direction = renormalized(v.frame.to_world(local / dist));
+  out.pdf = dist_over_r * dist_over_r * (dist / cos_light_times_dist) / (kTwoPi<T> * (T(1) - s));
   if (!std::isfinite(out.pdf) || !(out.pdf > T(0))) return DirectionSample<T>::none(NoSample::kTooSmall);
   return out;
 }
@@ -163,7 +157,7 @@ template <class T> T pdf_sphere_visible_area(const SphereView<T>& v, const Spher
   const T cos_light = std::sqrt(std::max(T(0), (T(1) - q) * (T(1) + q)));
   if (!(cos_light > T(0)) || !(wl.z() > T(0))) return T(0);
   const T t_over_r = d_over_r * wl.z() - cos_light;
-  const T pdf = t_over_r * t_over_r / (cos_light * kTwoPi<T> * ((d - r) / d));  // 1 - r/d as in the sampler
+  const T pdf = t_over_r * t_over_r / (cos_light * kTwoPi<T> * (T(1) - T(1) / d_over_r));
   return std::isfinite(pdf) ? pdf : T(0);
 }
 

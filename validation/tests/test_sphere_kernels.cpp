@@ -92,9 +92,8 @@ TYPED_TEST(SphereKernels, SamplesAreUnitDirectionsInsideTheConeWithMatchingPdf) 
 }
 
 // A sphere 0.9 of the largest finite T away (d / r = 3). fuzz_sphere_float 62328c27... (d = 3.4e38: a zero direction,
-// UBSan division by zero in renormalized; issue 7) was lost with its machine before it was kept; sphere.h now forms
-// the sampled point relative to d. This geometry passes on the old kernel too: it states the property, it does not
-// reproduce that input.
+// UBSan division by zero in renormalized; issue 7) was lost with its machine before it was kept. This geometry
+// states the property; it does not reproduce that input (the kernel passes it unchanged).
 TYPED_TEST(SphereKernels, SamplesOfASphereNearTheLargestFiniteDistanceAreUnitDirectionsWithMatchingPdf) {
   using T = TypeParam;
   const T m = std::numeric_limits<T>::max();
