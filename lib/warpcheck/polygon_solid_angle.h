@@ -22,6 +22,7 @@ template <class T> struct PolygonFanView {
   std::array<Vec3<T>, kMaxFanVertices> p{};           // vertex - shading point
   std::array<Vec3<T>, kMaxFanVertices> e{};           // p_k - p_0, from the light's own vertices if unclipped
   std::array<Vec3<T>, kMaxFanVertices> u{};           // p_k / |p_k|
+  std::array<T, kMaxFanVertices> len{};               // |p_k| by stableNorm (norm() underflows for |p| < 1e-154)
   // The cone is {w : inward_j . w >= 0, j < planes}: unclipped, inward_j = p_j x p_{j+1}; clipped, the
   // light's own edge planes (from V_j - x) and the horizon, never planes through two clip points, whose
   // normal is undetermined when the clip points (nearly) coincide (found by fuzz_polygon_solid_angle_double:
@@ -39,11 +40,11 @@ template <class T> struct PolygonFanView {
 
 // u_b - u_a for u = p / |p|, from the edge e = p_b - p_a without cancellation:
 // u_b - u_a = (e |p_a| - p_a (|p_b| - |p_a|)) / (|p_a| |p_b|), |p_b| - |p_a| = e.(p_a + p_b) / (|p_a| + |p_b|).
-template <class T> Vec3<T> unit_difference(const Vec3<T>& pa, const Vec3<T>& pb, const Vec3<T>& e) {
+// na = |p_a|, nb = |p_b| (PolygonFanView::len).
+template <class T> Vec3<T> unit_difference(const Vec3<T>& pa, T na, const Vec3<T>& pb, T nb, const Vec3<T>& e) {
   // Grouped as (e - u_a (|p_b| - |p_a|)) / |p_b| with the dot product taken against (p_a + p_b) / (|p_a| + |p_b|):
   // no product of two lengths, which underflows for a light ~1e-160 from x (UBSan: division by zero, found by
   // fuzz_polygon_solid_angle_double 0f46b33f..., issue 7).
-  const T na = pa.stableNorm(), nb = pb.stableNorm();  // norm() squares, and underflows to 0 for |p| < 1e-154
   const T dn = e.dot(Vec3<T>((pa + pb) / (na + nb)));
   return (e - (pa / na) * dn) / nb;
 }
@@ -106,6 +107,7 @@ template <class T> PolygonFanView<T> make_polygon_fan_view(const PolygonLightGeo
   }
   for (int k = 0; k < f.count; ++k) {
     f.u[k] = safe_normalized(f.p[k]);
+    f.len[k] = f.p[k].stableNorm();
     if (f.u[k].isZero()) return f.reason = NoSample::kNonFinite, f;
   }
   if (!clipped) {
@@ -164,7 +166,7 @@ template <class T> PolygonSolidAngleView<T> make_polygon_solid_angle_view(const 
     // |p_0| |p_k| |p_{k+1}| underflows to 0 for a light ~1e-110 from x (UBSan: division by zero, found by
     // fuzz_polygon_solid_angle_double 0f46b33f..., issue 7), and the scaled edges have the size of the light's
     // angular extent.
-    v.g0[k] = f.u[0].dot(kahan_cross(Vec3<T>(f.e[k] / f.p[k].stableNorm()), Vec3<T>(f.e[k + 1] / f.p[k + 1].stableNorm())));
+    v.g0[k] = f.u[0].dot(kahan_cross(Vec3<T>(f.e[k] / f.len[k]), Vec3<T>(f.e[k + 1] / f.len[k + 1])));
     // Eq. 13's denominator 1 + u0.uk + u0.uk1 + uk.uk1 = G2 + G1 with G2 = 1 + u0.uk, G1 = uk1 . (u0 + uk), stored
     // for the sampler, which must use the same values as the area (an area from one rounding and a sample from
     // another put the sample past the triangle's far edge: 8.9e-8 rad outside a thin fan triangle, found by
@@ -256,10 +258,10 @@ template <class T> DirectionSample<T> sample_polygon_solid_angle(const PolygonSo
   const Vec3<T> r = (g0 * c - g1 * s) * v0 + (g2 * s) * v2;
   const T r2 = r.squaredNorm();
   // Scaled before the product, as G0 in make_polygon_solid_angle_view (|p_2| |p_0| underflows for tiny p).
-  const Vec3<T> v2_x_v0 = kahan_cross(Vec3<T>(f.e[k + 1] / f.p[k + 1].stableNorm()), v0);
+  const Vec3<T> v2_x_v0 = kahan_cross(Vec3<T>(f.e[k + 1] / f.len[k + 1]), v0);
   const Vec3<T> offset = r2 > T(0) ? Vec3<T>((T(2) * g2 * s / r2) * kahan_cross(r, v2_x_v0)) : Vec3<T>::Zero();
   // d = v2' - v1 = (v0 - v1) + offset, with v0 - v1 from the edge e_k.
-  const Vec3<T> d = -unit_difference(f.p[0], f.p[k], f.e[k]) + offset;
+  const Vec3<T> d = -unit_difference(f.p[0], f.len[0], f.p[k], f.len[k], f.e[k]) + offset;
   DirectionSample<T> out;
   out.direction = sample_arc(v1, d, u[1]);
   if (out.direction.isZero()) return DirectionSample<T>::none(NoSample::kNonFinite);
