@@ -106,6 +106,19 @@ template <class T> Vec3<T> polygon_area_vector(const PolygonLight<T>& p) {
 // an ulp per coordinate is eps / 2 of |V|_inf; 4 eps leaves room for a conversion or a transform before us.
 template <class T> constexpr T kPolygonVertexRounding = T(4) * std::numeric_limits<T>::epsilon();
 
+// check_polygon's planarity tolerance (a length): vertices may leave the plane of the area vector by this much.
+// Input rounding of coordinates of size `magnitude` moves a vertex by ~eps magnitude; beyond that we allow
+// 8 sqrt(eps) of the polygon's width (a clearly non-planar or reflex polygon exceeds it by far). The width, not
+// the diameter: a thin polygon whose vertices may leave its plane by a fraction of its diameter has no
+// meaningful plane (found by fuzz_polygon_solid_angle_double, 4252de58...: width 11, diameter 1.3e8, one vertex
+// 7.9 off the plane of the others accepted with the old tolerance 16, samples 9.2e-3 rad outside the light in
+// that campaign; issue 4). For a convex polygon |area2| / diameter = 2 area / diameter lies between the width w
+// and 2 w (it contains a triangle on its diameter of height >= w / 2 and lies in a strip of width w).
+template <class T> T polygon_planarity_tolerance(T width, T magnitude) {
+  const T eps = std::numeric_limits<T>::epsilon();
+  return T(8) * std::sqrt(eps) * width + T(64) * eps * magnitude;
+}
+
 // kNone for a valid light; otherwise kNonFinite, kZeroSize or kInvalidGeometry, with a message if asked.
 // vertex_rounding: each vertex V_k is known to vertex_rounding |V_k|_inf (a caller that computed the vertices,
 // such as ltc.h's M^-1 P, passes its own bound).
@@ -139,16 +152,9 @@ NoSample check_polygon(const PolygonLight<T>& p, std::string* message = nullptr,
   const T area2_norm = area2.norm();
   if (!(area2_norm > T(0)) || !std::isfinite(area2_norm)) return fail(NoSample::kZeroSize, "zero area");
   const Vec3<T> nhat = area2 / area2_norm;
-  // Tolerances: input rounding of coordinates of size `magnitude` moves a vertex by ~eps magnitude; beyond
-  // that we allow 8 sqrt(eps) of the polygon's width (a clearly non-planar or reflex polygon exceeds it by far).
-  // The width, not the diameter: a thin polygon whose vertices may leave its plane by a fraction of its
-  // diameter has no meaningful plane (found by fuzz_polygon_solid_angle_double, 4252de58...: width 11, diameter
-  // 1.3e8, one vertex 7.9 off the plane of the others accepted with the old tolerance 16, samples 9.2e-3 rad
-  // outside the light in that campaign; issue 4). For a convex polygon |area2| / diameter = 2 area / diameter lies between the
-  // width w and 2 w (it contains a triangle on its diameter of height >= w / 2 and lies in a strip of width w).
   const T eps = std::numeric_limits<T>::epsilon();
   const T width = area2_norm / diameter;
-  const T tol = T(8) * std::sqrt(eps) * width + T(64) * eps * magnitude;
+  const T tol = polygon_planarity_tolerance(width, magnitude);
   // A polygon narrower than its own planarity tolerance (in effect, narrower than its coordinates' rounding) has
   // an undetermined plane: rotated about its long axis it stays within the tolerance. Its area vector is rounding
   // noise, and kernels and references disagree about which side of it a direction lies on (found by
@@ -285,6 +291,12 @@ PolygonView<T> make_polygon_view(const PolygonLightGeometry<T>& g, T vertex_roun
     // normal made of rounding noise (found by fuzz_polygon_projected_double: samples up to 0.58 rad outside a
     // polygon touching the horizon, issue 7).
     if (std::abs(l.z()) <= T(8) * std::numeric_limits<T>::epsilon() * l.cwiseAbs().maxCoeff()) l.z() = T(0);
+    // Likewise a vertex within rounding of the zenith is at it: its azimuth is rounding noise, and a subnormal xy
+    // (x a subnormal away from the vertex's vertical) has too few digits for the sectors' cross products (found
+    // by fuzz_ltc_double 156dd709...: M = I, x = (-4.9e-324, 0, 0) under the vertex (0, -4, 0) with n = -y:
+    // A_Sigma 0.912 instead of 0.680, issue 7). polygon_projected.h then takes the central case.
+    const T xy_rounding = T(8) * std::numeric_limits<T>::epsilon() * l.cwiseAbs().maxCoeff();
+    if (std::abs(l.x()) <= xy_rounding && std::abs(l.y()) <= xy_rounding) l.x() = l.y() = T(0);
     v.local.v[i] = l;
   }
   return v;

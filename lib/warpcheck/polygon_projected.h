@@ -380,6 +380,22 @@ PolygonProjectedView<T> make_polygon_projected_view(const PolygonLightGeometry<T
   PolygonProjectedView<T> v;
   const PolygonView<T> pv = make_polygon_view(g, vertex_rounding);
   if (!pv.valid()) return v.reason = pv.reason, v;
+  // The light must be resolved by its local coordinates. V_k - x is rounded to eps (|V_k|_inf + |x|_inf), and
+  // where that is comparable to the light's own extent the local polygon is rounding noise: its turns and the
+  // signs of its edges' n_z wind both ways, and the sector chains (Fig. 3b) are not those of any light (found by
+  // fuzz_polygon_projected_double 3c4c6d32 and ee5d7338: an octagon of diameter 32 seen from 1.7e17 away, the
+  // zenith sampled, 0.64 and 0.85 rad outside, issue 7). Below 64 eps of the coordinates' scale the light is
+  // also narrower than the fuzz checks' direction tolerance (fuzz/targets/common.h), so no sample can be told
+  // from one of its neighbourhood: "too small" (double: 1.4e-14 of the scale; float: 7.6e-6).
+  {
+    T extent = 0, scale = 0;
+    for (int i = 0; i < g.light.count; ++i) {
+      extent = std::max(extent, Vec3<T>(g.light.vertices[i] - g.light.vertices[0]).cwiseAbs().maxCoeff());
+      scale = std::max(scale, g.light.vertices[i].cwiseAbs().maxCoeff());
+    }
+    scale += g.shading.position.cwiseAbs().maxCoeff();
+    if (!(extent > T(64) * std::numeric_limits<T>::epsilon() * scale)) return v.reason = NoSample::kTooSmall, v;
+  }
   v.frame = pv.frame;
   v.flip_y = pv.plane_distance < T(0);
   {
@@ -409,7 +425,16 @@ PolygonProjectedView<T> make_polygon_projected_view(const PolygonLightGeometry<T
   }
   if (!any_positive) return v.reason = NoSample::kTooSmall, v;  // no projected area representable
   auto xy = [&](int i) { return Vec2<T>(v.clipped.v[(i % m + m) % m].x(), v.clipped.v[(i % m + m) % m].y()); };
-  v.central = !any_negative || winds_around_zenith(v.clipped);
+  // A vertex at the zenith (make_polygon_view puts one within rounding of it there) puts the zenith on the boundary:
+  // the central decomposition is then exact, each edge's sector a triangle with its apex at the zenith (the two
+  // edges at that vertex radial, of area 0), and every other edge has the zenith on its inner side, so an n_z < 0 is
+  // rounding noise (its sector gets area 0). The winding number sees only the other edges there and gives the
+  // decentral case, whose chains do not exist: the radial edges have sign 0, and a noise sign became the only inner
+  // chain (found by fuzz_ltc_double 403f9cc0...: M = I, an edge 4e-15 long with n_z = -1e-17, A_Sigma 4.9e-32
+  // instead of 0.708; issue 7).
+  bool zenith_vertex = false;
+  for (int i = 0; i < m; ++i) zenith_vertex = zenith_vertex || (v.clipped.v[i].x() == T(0) && v.clipped.v[i].y() == T(0));
+  v.central = !any_negative || zenith_vertex || winds_around_zenith(v.clipped);
   if (v.central) {
     // Sec. 3.1, Fig. 3a: one sector per edge. Its sine s0 x s1 is n_{j,z} >= 0 by construction.
     for (int j = 0; j < m; ++j) {
