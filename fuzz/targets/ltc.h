@@ -185,28 +185,47 @@ template <class T> void check_ltc(FuzzedDataProvider& in, const Mutation& mutate
   const bool reflecting = finite_input && ref.det < -e * hadamard;
 
   if (view.valid() && checkable) {
-    // The normaliser. A_Sigma of M^-1 P moves by at most (boundary length <= 2 pi) x (angular displacement of the
-    // transformed polygon): its vertices are the exact transforms of world vertices moved by e kappa_w + |E|, plus
-    // the rounding of the products Minv_T l (e in the transformed space); M^-1 stretches world angles at a vertex
-    // by |l_k| / (sigma_3 |M^-1 l_k|); the sampler's clip points move by e kappa_t; the sector sum rounds (16 eps).
-    const L a_ref = reference_projected_solid_angle(ref.transformed);
-    L stretch_inv = 0;
-    for (int i = 0; i < ref.transformed.light.count; ++i) {
-      const Vec3<L> l = ref.m * ref.transformed.light.vertices[i];
-      // A vertex at the shading point (length 0): the stretch is unbounded, and the check below is skipped
-      // (the reference divided by 0 there: UBSan, fuzz_ltc_double 5288b69a, issue 7).
-      const L vn = ref.transformed.light.vertices[i].norm();
-      stretch_inv = vn > 0 ? std::max(stretch_inv, l.norm() / (ref.sigma3 * vn)) : std::numeric_limits<L>::infinity();
-      if (!(vn > 0)) break;
+    // The normaliser, in two steps, each against its own conditioning. (1) The kernel's transformed polygon
+    // M^-1 P (ltc_transformed_polygon of the kernel's local polygon, in T) against the exact one: the vertices are
+    // the exact transforms of world vertices moved by e kappa_w + |E|, which M^-1 stretches as angles by
+    // |l_k| / (sigma_3 |M^-1 l_k|), plus the product's rounding (e). (2) A_Sigma against Lambert's formula for the
+    // kernel's own transformed polygon: the sampler's clip points and edges move by e (1 + kappa_t) as angles, over
+    // a boundary of length <= 2 pi, and the sector sum rounds (16 eps). One bound for both, as before, had to
+    // carry step (1)'s displacement through step (2)'s leverage kappa_t (the vertices' magnitude over an edge's
+    // distance from the origin), which it did not: fuzz_ltc_double a70e6c5b, cond(M) 7e10, a transformed edge with
+    // ends 1.1e11 away passing 4.6e5 from the origin, kappa_t 9.6e5; the kernel's vertices 0.41 off along the light's
+    // plane (3.7e-12 rad), A_Sigma 5.3e-7 off relative, allowed 1.5e-7; with the product of the two worst cases
+    // the bound would be 4.2e-2, no test at all (issue 7). A_Sigma's sensitivity to the world's rounding is the
+    // problem's conditioning, not the kernel's error.
+    const PolygonLightGeometry<T> kt = ltc_transformed_polygon(make_polygon_view(g.polygon), view.m_inv);
+    PolygonLightGeometry<L> kt_l;
+    kt_l.shading.position = Vec3<L>::Zero(), kt_l.shading.normal = Vec3<L>(0, 0, 1);
+    kt_l.light.count = kt.light.count;
+    for (int i = 0; i < kt.light.count; ++i) kt_l.light.vertices[i] = kt.light.vertices[i].template cast<L>();
+    for (int i = 0; i < ref.transformed.light.count && i < kt.light.count; ++i) {
+      const Vec3<L> r = ref.transformed.light.vertices[i], k = kt_l.light.vertices[i];
+      const Vec3<L> l = ref.m * r;
+      // A vertex at the shading point (length 0): the stretch is unbounded, and the check is skipped (the
+      // reference divided by 0 there: UBSan, fuzz_ltc_double 5288b69a, issue 7).
+      const L rn = r.norm(), kn = k.norm();
+      if (!(rn > 0) || !(kn > 0)) continue;
+      const L stretch = l.norm() / (ref.sigma3 * rn);
+      const L allowed = stretch * (e * kappa_w + ref.inverse_error) + e;
+      const L angle = 2 * std::asin(std::min(L(1), Vec3<L>(r / rn - k / kn).norm() / 2));
+      if (allowed < L(0.5))
+        WARPCHECK_FUZZ_REQUIRE(angle <= allowed, "a vertex of M^-1 P off its exact transform",
+                               describe(g, Vec2<T>(Vec2<T>::Zero()), "ltc view")
+                                   << "vertex " << i << " angle " << angle << " allowed " << allowed << "\n");
     }
-    const L shift = stretch_inv * (e * kappa_w + ref.inverse_error) + e * (1 + kappa_t);
-    const L rel = a_ref > 0 ? kTwoPi<L> * shift / a_ref + 16 * eps<T>() : L(1);
+    const L a_ref = reference_projected_solid_angle(kt_l);
+    const L kappa_k = polygon_kappa<L, T>(kt_l, true);
+    const L rel = a_ref > 0 ? kTwoPi<L> * e * (1 + kappa_k) / a_ref + 16 * eps<T>() : L(1);
     const L a = L(mutate.normaliser(view.transformed.projected_solid_angle));
     if (rel < L(0.5))
       WARPCHECK_FUZZ_REQUIRE(std::abs(a / a_ref - 1) <= rel, "A_Sigma(M^-1 P) differs from Lambert's formula",
                              describe(g, Vec2<T>(Vec2<T>::Zero()), "ltc view")
-                                 << "A_Sigma " << a << " reference " << a_ref << " ratio - 1 " << (a / a_ref - 1)
-                                 << " allowed " << rel << "\n");
+                                 << "A_Sigma " << a << " reference (of the kernel's M^-1 P) " << a_ref << " ratio - 1 "
+                                 << (a / a_ref - 1) << " allowed " << rel << "\n");
   }
 
   const int samples = in.ConsumeIntegralInRange<int>(1, 3);
