@@ -135,16 +135,20 @@ template <class T> LtcReference ltc_reference(const LtcPolygonGeometry<T>& g) {
   if (!(smin > 0) || !(nn > 0) || !std::isfinite(nn)) return r;
   r.defined = true;
   r.sigma1 = smax, r.sigma3 = smin;
-  Mat3<T> inv_t;  // as make_ltc_polygon_view computes it
+  Mat3<T> inv_t;  // the kernel's (ltc_inverse, as make_ltc_polygon_view computes it); both residuals
   T det_t;
-  bool invertible = false;
-  g.m.computeInverseAndDetWithCheck(inv_t, det_t, invertible, T(0));
-  if (invertible && inv_t.allFinite()) r.inverse_error = (r.m * inv_t.template cast<L>() - Mat3<L>::Identity()).norm();
+  if (ltc_inverse(g.m, &inv_t, &det_t))
+    r.inverse_error = std::max((r.m * inv_t.template cast<L>() - Mat3<L>::Identity()).norm(),
+                               (inv_t.template cast<L>() * r.m - Mat3<L>::Identity()).norm());
   r.frame = Frame<L>::from_z(Vec3<L>(n / nn));
-  L det_l;
-  bool invertible_l = false;
-  r.m.computeInverseAndDetWithCheck(r.m_inv, det_l, invertible_l, L(0));  // not inverse(): it divides by 0 for singular M
-  if (!invertible_l) return r.defined = false, r;
+  // LU with full pivoting, not the cofactor formula: that one's inverse of an ill-conditioned M is a right inverse
+  // only, even in long double (fuzz_ltc_double f84856d2: |X M - I| 2.2), and not inverse(): it divides by 0 for a
+  // singular M. sigma_min > 0 above; a zero pivot is tested all the same.
+  Eigen::FullPivLU<Mat3<L>> lu(r.m);
+  lu.setThreshold(L(0));  // any nonzero pivot counts, as the cofactor formula accepted any nonzero determinant
+  if (!(lu.rank() == 3)) return r.defined = false, r;
+  r.m_inv = lu.inverse();
+  if (!r.m_inv.allFinite()) return r.defined = false, r;
   r.m3 = r.m_inv.row(2).transpose();
   r.transformed.shading.position = Vec3<L>::Zero();
   r.transformed.shading.normal = Vec3<L>(0, 0, 1);

@@ -29,6 +29,24 @@ template <class T> struct LtcPolygonGeometry {
   }
 };
 
+// M^-1 and |M| for |M| > 0, from Gaussian elimination with full pivoting (Eigen's FullPivLU): false for a singular
+// or reflecting M and for one whose inverse or 1 / |M| overflows. Not the cofactor formula of Eigen's inverse() /
+// computeInverseAndDetWithCheck for 3x3: it is not backward stable, and for an ill-conditioned M its inverse is
+// a right inverse only (found by fuzz_ltc_double f84856d2: cond(M) 6e10, |M X - I| 1.6e-58 but |X M - I| 2.2, so
+// the sample's pdf from M c and pdf(direction) from X w, 0.83 % apart; issue 7). LU with pivoting gives an X
+// with X = (M + dM)^-1, |dM| ~ eps |M|, both residuals ~ eps cond(M) (1.8e-62 and 4e-62 there). The
+// determinant is the pivots' product, tested before inverse() divides by the pivots: a zero pivot makes it 0.
+// (An earlier cofactor determinant() was 1.4e-17 where inverse()'s own expansion was 0: a division by zero under
+// UBSan, fuzz_ltc_double d6818c25; issue 7.)
+template <class T> bool ltc_inverse(const Mat3<T>& m, Mat3<T>* m_inv, T* det) {
+  if (!m.allFinite()) return false;
+  const Eigen::FullPivLU<Mat3<T>> lu(m);
+  *det = lu.determinant();
+  if (!(*det > T(0)) || !std::isfinite(*det) || !std::isfinite(T(1) / *det)) return false;
+  *m_inv = lu.inverse();
+  return m_inv->allFinite();
+}
+
 // The LTC density p_M at a unit direction given in the shading frame (m_inv = M^-1, det_inv = |M^-1|).
 template <class T> T ltc_density_local(const Mat3<T>& m_inv, T det_inv, const Vec3<T>& l) {
   const Vec3<T> o = m_inv * l;
@@ -78,15 +96,9 @@ template <class T> LtcPolygonView<T> make_ltc_polygon_view(const LtcPolygonGeome
   v.frame = pv.frame;
   v.planes = polygon_inward_planes(g.polygon, pv, v.inward.data());
   v.m = g.m;
-  // |M| > 0 (Sec. 4.1). A singular or reflecting M has no LTC; an M whose inverse overflows neither. One
-  // determinant for the test and the inverse: inverse() divides by its own cofactor expansion, which can be 0
-  // where determinant() is a tiny positive number (found by fuzz_ltc_double under UBSan's float-divide-by-zero,
-  // issue 7); computeInverseAndDetWithCheck divides only by a determinant it has tested.
-  bool invertible = false;
-  g.m.computeInverseAndDetWithCheck(v.m_inv, v.det, invertible, T(0));
-  if (!invertible || !(v.det > T(0)) || !std::isfinite(v.det)) return v.reason = NoSample::kInvalidGeometry, v;
+  // |M| > 0 (Sec. 4.1). A singular or reflecting M has no LTC; an M whose inverse overflows neither.
+  if (!ltc_inverse(g.m, &v.m_inv, &v.det)) return v.reason = NoSample::kInvalidGeometry, v;
   v.det_inv = T(1) / v.det;
-  if (!v.m_inv.allFinite() || !std::isfinite(v.det_inv)) return v.reason = NoSample::kInvalidGeometry, v;
   // M^-1 P is convex, but its computed vertices carry the rounding of the frame change (a few eps |v|) and of
   // the product: 3 eps |M^-1|_F |v|_2 <= 3 eps cond_F(M) |M^-1 v|_2 <= 3 sqrt(3) eps cond_F(M) |M^-1 v|_inf.
   // check_polygon forgives reflex turns up to that rounding (and no further: polygon.h).

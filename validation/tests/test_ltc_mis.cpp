@@ -92,6 +92,35 @@ TEST(Ltc, PdfEqualsTheSamplePdfForANearSingularTransform) {
   EXPECT_NEAR(pdf_ltc_polygon(v, s.direction) / s.pdf, 1, 16 * std::numeric_limits<double>::epsilon());
 }
 
+// M^-1 is a two-sided inverse for an ill-conditioned M (cond 6e10): the 3x3 cofactor formula of Eigen's
+// inverse() and computeInverseAndDetWithCheck gives |M X - I| = 1.6e-58 but |X M - I| = 2.2 here, and the sample's
+// pdf (from M c) and pdf(direction) (from X w) were 0.83 % apart (fuzz_ltc_double f84856d2, issue 7). With LU
+// (ltc_inverse) both residuals are ~eps cond(M) or less, and the two densities agree to what the conditioning
+// leaves: w is rounded to eps, which X stretches by |M c| / sigma_3 = 8e7 into 3e-8 rad of c, moving |M c|^3 by up
+// to 3 sigma_1 3e-8 / |M c| = 7e-5 relative (measured: 3.2e-6).
+TEST(Ltc, TheInverseIsTwoSidedAndPdfMatchesTheSamplePdfForATransformOfCondition6e10) {
+  LtcPolygonGeometry<double> g;
+  g.polygon = PolygonLightGeometry<double>{
+      ShadingPoint<double>{{-1.9899291992187504, 0.031186217543507051, 0.034569129277040013}, {-0., 1.4142135623730949, -1.4142135623730951}},
+      PolygonLight<double>{{3.9798583984375, 0, 0}, {-1.9899291992187491, 0.43301270189221935, 0.43301270189221935},
+                           {-1.9899291992187518, -0.43301270189221919, -0.43301270189221919}}};
+  g.m << 3.9999999995343387, -2, -7.1515105099495211e-62, 4, -2.0000000004656613, -7.1515105099495211e-62, 4, -2,
+      -4.6566128730773926e-10;
+  Mat3<double> x;
+  double det = 0;
+  ASSERT_TRUE(ltc_inverse(g.m, &x, &det));
+  using L = long double;
+  const Mat3<L> ml = g.m.cast<L>(), xl = x.cast<L>();
+  const L bound = 8 * std::numeric_limits<double>::epsilon() * 6e10L;
+  EXPECT_LE((ml * xl - Mat3<L>::Identity()).norm(), bound);
+  EXPECT_LE((xl * ml - Mat3<L>::Identity()).norm(), bound);
+  const auto v = make_ltc_polygon_view(g);
+  ASSERT_TRUE(v.valid());
+  const auto s = sample_ltc_polygon(v, Vec2<double>(0.0078125, 0.0025777816772490914));
+  ASSERT_TRUE(s.valid());
+  EXPECT_NEAR(pdf_ltc_polygon(v, s.direction) / s.pdf, 1, 7e-5);
+}
+
 // pdf() is positive at samples well inside the light when two vertices 3e51 apart (at 2e67) lie on the horizon
 // up to rounding: the edge planes of the transformed polygon M^-1 P came from rounded vertices, and that edge's
 // became the horizon with a random orientation, pdf 0 at samples 0.09 rad inside (fuzz_ltc_double 834135fe,
