@@ -41,6 +41,26 @@
 //    Boost's TOMS 748 root finder, then y uniform on R's chord at x. (The projected spherical cap sampler of
 //    Peters & Dachsbacher 2019 would serve here too; lib/warpcheck/projected_cap.h did not exist when this
 //    was written, so this is our own exact method; its cost is one 1D root find per sample near the horizon.)
+//  * The crescent's tip (cos t < 0, x0 in (-1, 1); issue 5). E touches the unit circle at P0 = (x0, +-c0),
+//    c0 = sqrt(1 - x0^2): with c = sqrt(1 - x^2) and E's half-height m at x, multiplying c^2 - m^2 =
+//    cos^2(alpha) - x^2 + (x - x_c)^2 / cos^2(t) by cos^2(t) gives (x sin t - cos(alpha))^2, so
+//    c^2 - m^2 = tan^2(t) (x - x0)^2 (a double root at x0: the tangency). R's half-chord is then
+//    c - m = tan^2(t) (x - x0)^2 / (c + m), without cancellation; tan(t) (x - x0) = sin(t) sin(alpha) (x - x0) / A.
+//    The mass of R between x0 and x ~ (2/3) tan^2(t) (x - x0)^3 / c0 was the difference of disk(x0..x) and
+//    E(x0..x), each ~2 c0 (x - x0): in float x(u0) was all cancellation for small u0 (pdf(dir) and the warp's
+//    area element 2.4e-4 apart at u0 = 1.5e-4 against a tolerance of 1.6e-5, and 2 of 1e7 samples declined with
+//    x = x0). We take it in closed form from areas that do not cancel (derived here, not in the paper): for the
+//    upper half, between x0 and x <= x_c + A, (circular segment on the chord P0 -> (x, c)) - (E's segment on the
+//    chord P0 -> (x, m)) + (the triangle between the two chords, (x - x0)(c - m) / 2), each segment from its
+//    half-angle by the series of projected_cap.h's cut_disk_area_from_angle (E's after the affine map onto the unit
+//    disk, times its area factor sin(alpha) A). Right of E's end the same with E's whole segment from P0 and the
+//    trapezoid under the disk's chord. For small x - x0 all three terms are cubic in x - x0 like the mass: with D
+//    the upper half's mass, the triangle is 3 D / 2, E's segment exceeds the circle's (~(x - x0)^3 / (12 c0^3)) by
+//    D / 2, so the terms' magnitudes add up to (2 + 1 / (tan^2(t) c0^2)) D (2.02 D in the registry's crescent),
+//    independently of x - x0. It is one formula on [x0, x_c + A] (no switch, hence no new kink), and C1 at
+//    x_c + A, already a kink of the warp. Measured in float on the registry's crescent: the CDF within 2.5 eps of
+//    the long double kernel's on the same float geometry for x - x0 from 1e-5 to 1 - x0 (the difference form:
+//    2.4e3 relative at 1e-4, 8e-3 at 1e-2).
 #pragma once
 
 #include <algorithm>
@@ -243,6 +263,10 @@ template <class T> struct CosineCapView {
   T xc = 0, A = 0, x0 = 0;     // ellipse centre and x semi-axis; x >= x0: full chord side
   T seg0 = 0;                  // area of the unit disk right of x0, without cancellation (make_cosine_cap_view)
   bool ellipse_only = false;   // R = E (cap entirely above the horizon)
+  // The crescent with its tip at x0 in (-1, 1) (cos t < 0), where E touches the unit circle at (x0, +-c0):
+  // E's normalised abscissa tau0 = (x0 - x_c) / A there and its normalised half-height n0 = sqrt(1 - tau0^2).
+  bool tip = false;
+  T c0 = 0, tau0 = 0, n0 = 0;
   T area = 0;                  // projected solid angle of (cap, upper hemisphere) = area of R
 
   bool valid() const { return reason == NoSample::kNone; }
@@ -262,11 +286,57 @@ template <class T> struct CosineCapView {
     return theta <= kPi<T> / T(2) ? cut_disk_area_from_angle(theta) : kPi<T> - cut_disk_area_from_angle(kPi<T> - theta);
   }
   static T disk_right_of(T x) { return disk_right_of_angle(std::acos(std::clamp(x, T(-1), T(1)))); }
-  // Area of R with abscissa < x; the disk part between x0 and x as seg0 - (disk right of x).
+  // Area of R with abscissa < x; the disk part between x0 and x as seg0 - (disk right of x). The crescent with a
+  // tip (cos t < 0, x0 in (-1, 1)) by crescent_cdf, as a function of s = x - x0.
   T cdf(T x) const {
+    if (tip) return x > x0 ? crescent_cdf(x - x0) : T(0);
     const T disk = x > x0 ? std::max(T(0), seg0 - disk_right_of(x)) : T(0);
     if (cos_t >= T(0)) return ellipse_cdf(std::min(x, x0)) + disk;
     return x > x0 ? std::max(T(0), disk - (ellipse_cdf(x) - ellipse_cdf(x0))) : T(0);
+  }
+  // The crescent's chord at x = x0 + s, s >= 0: the disk's half-height c, E's half-height m (0 right of E), and
+  // R's half-chord w = c - m as (c^2 - m^2) / (c + m) = (sin t sin(alpha) s / A)^2 / (c + m) (header comment;
+  // s / A, not tan(t) s, which overflows for cos t -> 0). All from s, not from a rounded x = x0 + s.
+  struct CrescentChord {
+    T c, m, w;
+  };
+  CrescentChord crescent_chord(T s) const {
+    const T one_minus_x = (T(1) - x0) - s, one_plus_x = (T(1) + x0) + s;
+    const T c = std::sqrt(std::max(T(0), one_minus_x * one_plus_x));
+    if (!(A > T(0))) return {c, T(0), c};
+    const T v = s / A, one_minus_tau = (T(1) - tau0) - v;
+    if (!(one_minus_tau > T(0))) return {c, T(0), c};
+    const T m = sin_a * std::sqrt(one_minus_tau * (T(1) + tau0 + v));
+    const T ks = sin_t * sin_a * v;
+    const T w = c + m > T(0) ? std::min(c, ks * ks / (c + m)) : T(0);
+    return {c, m, w};
+  }
+  // Area of the crescent between x0 and x0 + s, without the cancellation of the difference form above (header
+  // comment): twice (upper half) the circular segment on the chord from the tip P0 = (x0, c0) to (x, c), minus E's
+  // segment on the chord from P0 to (x, m) (E's right end (x_c + A, 0) once x is past it), plus the polygon
+  // between the two chords and the vertical at x. Each segment as cut_disk_area_from_angle of its half-angle,
+  // atan2(|chord| / 2, distance of the chord's midpoint from the centre), E's in its normalised coordinates
+  // (tau, y / sin(alpha)) times the area factor sin(alpha) A; the chord's rise as a product, c0 - c =
+  // s (x0 + x) / (c0 + c).
+  T crescent_cdf(T s) const {
+    if (!(s > T(0))) return T(0);
+    const CrescentChord ch = crescent_chord(s);
+    const T c = ch.c;
+    const T sum_x = T(2) * x0 + s, sum_c = c0 + c;
+    const T rise_c = sum_c > T(0) ? s * sum_x / sum_c : T(0);
+    const T circle = cut_disk_area_from_angle(std::atan2(std::hypot(s, rise_c), std::hypot(sum_x, sum_c)));
+    T ellipse = T(0), polygon;
+    const T v_end = T(1) - tau0;  // E's right end at s = A (1 - tau0)
+    const T v = A > T(0) ? std::min(s / A, v_end) : T(0);
+    if (v > T(0)) {
+      const T tau = tau0 + v, n = std::sqrt(std::max(T(0), (v_end - v) * (T(1) + tau)));
+      const T sum_tau = tau0 + tau, sum_n = n0 + n;
+      const T rise_n = sum_n > T(0) ? v * sum_tau / sum_n : T(0);
+      ellipse = sin_a * A * cut_disk_area_from_angle(std::atan2(std::hypot(v, rise_n), std::hypot(sum_tau, sum_n)));
+    }
+    if (A > T(0) && s / A < v_end) polygon = s * ch.w / T(2);
+    else polygon = (c0 * (s - A * v_end) + c * s) / T(2);
+    return T(2) * std::max(T(0), circle - ellipse + polygon);
   }
   // Half-height of E at abscissa x (0 outside it).
   T ellipse_half_height(T x) const {
@@ -305,6 +375,12 @@ template <class T> CosineCapView<T> make_cosine_cap_view(const Cap<T>& cap, cons
   // half-angle 24 deg with its axis on the horizon, cos(t) = 5e-39, got the area of its degenerate ellipse, 2.5e-39,
   // and a density of 3e40 instead of 1455, issue 7).
   v.ellipse_only = v.cos_t >= T(0) && v.cos_a >= v.sin_t;
+  v.tip = v.cos_t < T(0) && v.x0 > T(-1) && v.x0 < T(1);
+  if (v.tip) {
+    v.c0 = std::sqrt((T(1) - v.x0) * (T(1) + v.x0));
+    v.tau0 = v.A > T(0) ? std::clamp((v.x0 - v.xc) / v.A, T(-1), T(1)) : T(1);
+    v.n0 = std::sqrt((T(1) - v.tau0) * (T(1) + v.tau0));
+  }
   v.area = v.ellipse_only ? kPi<T> * v.sin_a * v.A : v.cdf(T(1));
   if (!(v.area > T(0)) || !std::isfinite(v.area)) return v.reason = NoSample::kBelowHorizon, v;
   return v;
@@ -404,37 +480,65 @@ template <class T> Vec3<T> sample_cosine_cap_direction(const CosineCapView<T>& v
     T lo = T(-1), hi = T(1);
     if (v.cos_t >= T(0)) lo = std::max(lo, v.xc - v.A);
     else lo = std::max(lo, std::min(v.x0, T(1)));
-    // Right of x0 (cos t >= 0) R is the full disk chord, and the area right of x is disk_right_of(x): there x is
-    // found from that upper tail, (1 - u0) area, which keeps its relative precision as u0 -> 1 where the CDF's
-    // u0 area - cdf(x) cancels (float: pdf(dir) and the warp's area element 3.4e-5 apart at u0 = 0.9996 in the
-    // crossing configuration; issue 5). The switch is at x0, a kink of the warp anyway.
+    // Right of x_full (x0 for cos t >= 0, E's right end x_c + A for the crescent) R is the full disk chord, and the
+    // area right of x is disk_right_of(x): there x is found from that upper tail, (1 - u0) area, which keeps its
+    // relative precision as u0 -> 1 where the CDF's u0 area - cdf(x) cancels (float: pdf(dir) and the warp's area
+    // element 3.4e-5 apart at u0 = 0.9996 in the crossing configuration, and up to 5e-2 for u0 > 0.9999 in the
+    // crescent, measured against the long double sampler; issue 5). The switch is at x_full, a kink of the warp
+    // anyway (registered in kernels_sptd.h).
     const T upper = (T(1) - u[0]) * v.area;
-    const bool upper_tail = v.cos_t >= T(0) && v.x0 < T(1) && upper <= v.seg0;
-    if (upper_tail) lo = std::max(lo, v.x0);
-    auto f = [&](T x) { return upper_tail ? upper - CosineCapView<T>::disk_right_of(x) : v.cdf(x) - target; };
-    T flo = f(lo), fhi = f(hi);
-    if (flo >= T(0)) x = lo;
-    else if (fhi <= T(0)) x = hi;
+    const T x_full = v.cos_t >= T(0) ? v.x0 : v.xc + v.A;
+    const T seg_full = v.cos_t >= T(0) ? v.seg0 : CosineCapView<T>::disk_right_of(x_full);
+    // The upper tail is solved for the angle theta, x = cos(theta): near x = 1 a rounded x carries 1 - x, hence c
+    // and the direction, only to ulp(1) / (1 - x) (float: directions 7.7e-6 rad off the long double sampler's and
+    // pdf(dir) 1.7e-3 off at u0 = 1 - 6e-7 in the crescent); c = sin(theta) keeps its relative precision.
+    const bool upper_tail = x_full < T(1) && upper <= seg_full;
+    if (upper_tail) lo = T(0), hi = std::acos(std::max(T(-1), x_full));
+    // The crescent with a tip, left of x_full: solved for s = x - x0 on [0, x_full - x0] by crescent_cdf, to s's own
+    // relative precision (a relative tolerance on x ~ 0.4 leaves s = 1e-2 off by up to 1e-5 relative, and
+    // z ~ tan(t) s with it); the chord from s too (crescent_chord).
+    const bool by_s = v.tip && !upper_tail;
+    if (by_s) lo = T(0), hi = std::max(T(0), std::min(x_full, T(1)) - v.x0);
+    // The unknown q is theta in the upper tail, s = x - x0 in the crescent with a tip, and x otherwise.
+    auto f = [&](T q) {
+      return upper_tail ? CosineCapView<T>::disk_right_of_angle(q) - upper
+                        : by_s ? v.crescent_cdf(q) - target : v.cdf(q) - target;
+    };
+    T q;
+    const T flo = f(lo), fhi = f(hi);
+    if (flo >= T(0)) q = lo;
+    else if (fhi <= T(0)) q = hi;
     else {
       std::uintmax_t iters = 200;
       const auto tol = boost::math::tools::eps_tolerance<T>(std::numeric_limits<T>::digits - 2);
       const auto r = boost::math::tools::toms748_solve(f, lo, hi, flo, fhi, tol, iters);
-      x = (r.first + r.second) / T(2);
+      q = (r.first + r.second) / T(2);
     }
-    const T c = std::sqrt(std::max(T(0), (T(1) - x) * (T(1) + x)));
-    const T m = std::min(c, v.ellipse_half_height(x));
+    T c, m, w;  // the disk's and E's half-heights at x, and w = c - m (R's half-chord in the crescent)
+    if (upper_tail) {
+      x = std::cos(q), c = std::sin(q), m = T(0), w = c;  // right of x_full: R's chord is the disk's
+    } else if (by_s) {
+      const auto ch = v.crescent_chord(q);
+      x = v.x0 + q, c = ch.c, m = ch.m, w = ch.w;
+    } else {
+      x = q;
+      c = std::sqrt(std::max(T(0), (T(1) - x) * (T(1) + x)));
+      m = std::min(c, v.ellipse_half_height(x));
+      w = c - m;
+    }
     const T s = T(2) * u[1] - T(1);  // in [-1, 1)
     // 1 - |s| from u1 itself (exact), and c - |y| from it in each branch: the lift z = sqrt(c^2 - y^2) =
     // sqrt((c - |y|)(c + |y|)) of a point near the chord's end would otherwise be the difference of two nearly
     // equal squares (float: pdf(dir) and the warp's area element 7.4e-5 apart at u1 = 0.99985 in the crossing
-    // configuration, and 3 in 1e7 samples declined with z rounded to 0 in the crescent; issue 5).
+    // configuration, and 3 in 1e7 samples declined with z rounded to 0 in the crescent; issue 5). The branch by
+    // the inversion's piece, not by comparing a rounded cos(theta) with x0.
     const T one_minus_abs_s = T(2) * std::min(u[1], T(1) - u[1]);
     T c_minus_abs_y;
-    if (v.cos_t >= T(0) && x < v.x0) y = s * m, c_minus_abs_y = (c - m) + m * one_minus_abs_s;
-    else if (v.cos_t >= T(0)) y = s * c, c_minus_abs_y = c * one_minus_abs_s;
+    if (upper_tail || (v.cos_t >= T(0) && x >= v.x0)) y = s * c, c_minus_abs_y = c * one_minus_abs_s;
+    else if (v.cos_t >= T(0)) y = s * m, c_minus_abs_y = w + m * one_minus_abs_s;
     else {
-      y = std::copysign(m + (c - m) * std::abs(s), s);  // the crescent: jumps across E at u1 = 1/2
-      c_minus_abs_y = (c - m) * one_minus_abs_s;
+      y = std::copysign(m + w * std::abs(s), s);  // the crescent: jumps across E at u1 = 1/2
+      c_minus_abs_y = w * one_minus_abs_s;
     }
     z = std::sqrt(std::max(T(0), c_minus_abs_y * (c + std::abs(y))));
   }

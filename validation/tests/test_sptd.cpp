@@ -562,5 +562,51 @@ TEST(SptdSampling, FloatSamplesOfAUniformSptdWithItsPivotAt0999FarFromTheCapMatc
   EXPECT_LT(worst, 2e-6L);  // 16 ulps of float's directions; the unit-vector image gave 1.9e-4
 }
 
+// The clamped cosine's crescent (registry case sptd-cosine-cap/crescent: image cap's axis below n's horizon) in
+// float near its tip x0 (u0 -> 0) and near the disk's rim (u0 -> 1), against the long double sampler on the same
+// (float) geometry, exactly widened. Near x0 the crescent's mass grows like (x - x0)^3 while the difference form
+// disk(x0..x) - (E(x) - E(x0)) subtracts two terms ~2 c0 (x - x0), and near x = 1 the area right of x is a rounded
+// x's 1 - x; both left float's x(u) wrong by far more than its rounding. Measured by this test: worst 3.1e-7 rad
+// near the tip and 1.8e-7 near the rim, none declined; the difference form with x solved to x's relative
+// precision (the kernel before issue 5's crescent change): 5.7e-3 and 6.2e-4 rad, and 1699 of the 14700 samples
+// declined (x = x0 exactly, z = 0). (1 - d rounds to 1 in float for d < 6e-8: those u0 are left out.)
+TEST(SptdSampling, FloatCosineCapCrescentSamplesMatchLongDoubleToAFewUlpsNearTheTipAndTheRim) {
+  SptdCapGeometry<L> g;
+  g.sptd.pivot = Vec3L(0.2L, 0, 0.3L);
+  g.sptd.base = SptdBase::kClampedCosine;
+  g.sptd.base_axis = Vec3L(0, 0, -1);
+  g.cap = Cap<L>{Vec3L(1, 0, 0.2L).normalized(), 0.3L};
+  const auto vf = make_sptd_cap_view(g.cast<float>());
+  const auto vl = make_sptd_cap_view(g.cast<float>().cast<L>());  // the same (float) geometry, exactly
+  ASSERT_TRUE(vf.valid() && vl.valid());
+  ASSERT_TRUE(vf.cosine.cos_t < 0 && vf.cosine.x0 > -1 && vf.cosine.x0 < 1) << "not a crescent with a tip";
+  std::mt19937_64 r(5);
+  std::uniform_real_distribution<float> u(0, 1);
+  L worst_tip = 0, worst_rim = 0;
+  int declined = 0;
+  for (int e = 0; e <= 80; ++e) {
+    const float d = std::pow(10.0f, -1 - 0.1f * float(e));  // 1e-1 .. 1e-9
+    for (int j = 0; j < 100; ++j) {
+      const float u1 = u(r);
+      for (const float u0 : {d, 1 - d}) {
+        if (!(u0 < 1)) continue;
+        const auto sf = sample_sptd_cap(vf, Vec2<float>(u0, u1));
+        const auto sl = sample_sptd_cap(vl, Vec2<L>(u0, u1));
+        if (!sf.valid() || !sl.valid()) {
+          ++declined;
+          continue;
+        }
+        L& worst = u0 < 0.5f ? worst_tip : worst_rim;
+        worst = std::max(worst, (sf.direction.cast<L>() - sl.direction).norm());
+      }
+    }
+  }
+  std::printf("[ float ] crescent: worst |w_float - w_LD| %.3Lg rad near the tip, %.3Lg near the rim, %d declined\n",
+              worst_tip, worst_rim, declined);
+  EXPECT_EQ(declined, 0);
+  EXPECT_LT(worst_tip, 2e-6L);  // 16 ulps of float's directions
+  EXPECT_LT(worst_rim, 2e-6L);
+}
+
 }  // namespace
 }  // namespace warpcheck
