@@ -174,7 +174,6 @@ NoSample check_polygon(const PolygonLight<T>& p, std::string* message = nullptr,
   // light that its sampler still samples: pdf() 0 at its own samples (fuzz_ltc_double a8864f7e..., d3e18c5b...,
   // 1e7d91f3...: edges of length 7.5e-9 to 8 reflex by up to 0.8 rad in lights of diameter 16 to 1e14; issue 7).
   auto rounding = [&](int k) { return vertex_rounding * p.vertices[(k + p.count) % p.count].cwiseAbs().maxCoeff(); };
-  T turning = 0;
   for (int i = 0; i < p.count; ++i) {
     const Vec3<T> a = p.vertices[i] - p.vertices[(i + p.count - 1) % p.count];
     const Vec3<T> b = p.vertices[(i + 1) % p.count] - p.vertices[i];
@@ -194,7 +193,24 @@ NoSample check_polygon(const PolygonLight<T>& p, std::string* message = nullptr,
     // legitimate needle whose ends turn by pi - 1e-8.
     if (c < T(0) && std::abs(s) <= T(8) * eps * a.norm() * b.norm())
       return fail(NoSample::kInvalidGeometry, "polygon is not convex (a spike)");
-    turning += std::atan2(s, c);
+  }
+  // The turning number, over the edges whose projection onto the plane is longer than their ends' rounding. An
+  // edge within rounding of a point (in the plane) has no direction there: its turns atan2(s, c) with both products
+  // underflowing or rounding to 0 came out as 0 instead of the turn they share, and a polygon wound twice (eight
+  // vertices in the plane x = 0 with subnormal x, one edge 9e-308 long along x) summed to one revolution and
+  // passed as simple (found by fuzz_polygon_solid_angle_double b6ebf498..., a sample 0.16 rad outside; issue 7).
+  // Dropping such an edge joins its neighbours' turns into one, which keeps the sum a multiple of 2 pi.
+  std::array<Vec3<T>, kMaxPolygonVertices> kept;
+  int nk = 0;
+  for (int i = 0; i < p.count; ++i) {
+    const Vec3<T> e = p.vertices[(i + 1) % p.count] - p.vertices[i];
+    if (Vec3<T>(e - nhat.dot(e) * nhat).norm() > rounding(i) + rounding(i + 1)) kept[nk++] = e;
+  }
+  if (nk < 3) return fail(NoSample::kZeroSize, "fewer than three edges longer than their rounding");
+  T turning = 0;
+  for (int i = 0; i < nk; ++i) {
+    const Vec3<T>&a = kept[(i + nk - 1) % nk], &b = kept[i];
+    turning += std::atan2(nhat.dot(kahan_cross<T>(a, b)), a.dot(b));
   }
   if (std::abs(turning - kTwoPi<T>) > T(0.5)) return fail(NoSample::kInvalidGeometry, "polygon is not simple");
   if (message) message->clear();

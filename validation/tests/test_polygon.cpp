@@ -602,6 +602,19 @@ TYPED_TEST(PolygonKernels, ASpikeIsNotConvex) {
   EXPECT_EQ(check_polygon(collinear, &message), NoSample::kNone) << message;
 }
 
+// A polygon wound twice is not simple even where an edge within rounding of a point (here 9e-308 long, out of the
+// plane) makes its turns underflow: they came out as 0, the turning number as one revolution, and the light was
+// sampled 0.16 rad outside itself (fuzz_polygon_solid_angle_double b6ebf498, issue 7).
+TEST(PolygonKernels, APolygonWoundTwiceWithASubnormalEdgeIsNotSimple) {
+  const double m = std::numeric_limits<double>::min();
+  const PolygonLight<double> twice{Vec3<double>(0, -2, -m), Vec3<double>(0, 2, -2), Vec3<double>(-m, -4 * m, 2),
+                                   Vec3<double>(4 * m, 0, 2), Vec3<double>(-m, -2, -m), Vec3<double>(0, 0, -1),
+                                   Vec3<double>(0, 0, 0), Vec3<double>(0, 0, 1.0000000031710769e-30)};
+  std::string message;
+  EXPECT_EQ(check_polygon(twice, &message), NoSample::kInvalidGeometry);
+  EXPECT_NE(message.find("not simple"), std::string::npos) << message;
+}
+
 // check_polygon accepts vertices off the light's plane up to its planarity tolerance (about 8 sqrt(eps) of the
 // width). A shading point closer to the plane than that, with vertices on both sides of it, does not see a
 // convex spherical polygon, and which side of the light it is on is undetermined: edge-on (fuzz_polygon_projected_double
