@@ -174,21 +174,33 @@ template <class T> PolygonMargins polygon_margins(const PolygonLightGeometry<T>&
       // A light farther off its plane than that, but within check_polygon's planarity tolerance, is accepted as
       // the planar light it is near (polygon_planarity_tolerance, polygon.h; every kernel takes its side and its
       // edge-on test from the area vector), and its directions are known only up to its non-planarity: the angle
-      // by which flattening moves a vertex as seen from x, off_k / |flat_k - x|. Its flattening, within that
-      // angle, is an accepted displacement too. Where x sees an edge of the unflattened light end-on, that
+      // by which flattening moves a point of it as seen from x. Its flattening, within that angle, is an accepted
+      // displacement too. Where x sees an edge of the unflattened light end-on, that
       // edge's plane through x is set by the non-planarity alone and can cut the light's cone down to a plane
       // (found by fuzz_polygon_solid_angle_double 56a30637: a vertex 4.2e-11 off the plane of a light of width
       // 15, x on the line of its 5.8e-11 long edge up to a subnormal z; a sample on the edge V2 V3, 1.2e-10 rad
       // on the far side of the end-on edge's plane, and 8.7e-12 rad outside the flattened light, whose vertices
       // moved by up to 3.1e-11 rad; issue 7).
+      // The angle is off / dist over the light, not only at its vertices: a clip point or the nearest point of the
+      // light can be much closer to x than any vertex (a5fc8f53: the same light seen from 0.009 off its plane, a
+      // sample at a horizon clip point 1.5 from x with the vertices ~5.6 away, 6.6e-12 rad outside the flattened
+      // light). So dist is x's distance from the flattened polygon: from its plane where x's foot lies inside it,
+      // else from its nearest edge.
       const L planarity = diam > 0 ? L(polygon_planarity_tolerance<T>(T(an / diam), T(mag))) : L(0);
       if (off > delta / 2 && off <= planarity) {
-        L moved = 0;
+        const L height = nh.dot(Vec3<L>(xl - c));
+        const Vec3<L> foot = xl - height * nh;
+        bool inside = true;
+        L dist = std::numeric_limits<L>::infinity();
         for (int i = 0; i < n; ++i) {
-          const Vec3<L> vi = g.light.vertices[i].template cast<L>();
-          const L dist = Vec3<L>(flat.vertices[i] - xl).norm();
-          moved = std::max(moved, dist > 0 ? std::abs(nh.dot(Vec3<L>(vi - c))) / dist : L(std::numeric_limits<L>::infinity()));
+          const Vec3<L> a = flat.vertices[i], e = fe[i];
+          inside = inside && nh.dot(kahan_cross<L>(e, Vec3<L>(foot - a))) >= 0;
+          const L ee = e.squaredNorm();
+          const L t = ee > 0 ? std::clamp(Vec3<L>(xl - a).dot(e) / ee, L(0), L(1)) : L(0);
+          dist = std::min(dist, Vec3<L>(xl - (a + t * e)).norm());
         }
+        if (inside) dist = std::abs(height);
+        const L moved = dist > 0 ? off / dist : std::numeric_limits<L>::infinity();
         mm = std::max(mm, polygon_cone_margin<L, T>(flat, xl, Vec3<L>(w.template cast<L>()), fe.data()) + moved);
       }
     }
