@@ -649,24 +649,6 @@ TEST(PolygonProjected, ProjectedSolidAngleMatchesLambertWithADoubledVertexInside
   EXPECT_NEAR(v.projected_solid_angle / ref, 1, 1e-12) << v.projected_solid_angle << " vs " << ref;
 }
 
-// Sec. 3.1: a vertex at the zenith puts the zenith on the light's boundary, and the central decomposition is
-// exact. A hexagon seen from 3e-5 beside a vertex, with a vertex 8 eps from the zenith (put at it) and an edge 4e-15
-// long whose n_z = -1e-17 is rounding noise: the decentral case took that edge for the only inner chain, A_Sigma
-// 4.9e-32 instead of 0.708 (fuzz_ltc_double 403f9cc0 with M = I, issue 7).
-TEST(PolygonProjected, ProjectedSolidAngleMatchesLambertWithAVertexAtTheZenith) {
-  const PolygonLightGeometry<double> g = geom<double>(
-      {-0.1273642887492622, -10.738008116536452, 1.081344971704761},
-      {-12.677181692463837, 47.051874731980355, 8.0928367707429203},
-      {{0, -10.595186948776245, 0.99999999999999989}, {-0.12738118791250691, -10.738008116536452, 1.0813185000471728},
-       {-4.3530915195705404, 4.9459501274569995, 3.7789572286190678}, {3.755049622491299, 14.272737943463003, -1.3971750295925287},
-       {1.1446499483557506, -9.2562717483112031, 0.26927030274441022}, {2.8899990138081828e-15, -10.595186948776242, 0.999999999999998}});
-  const auto v = make_polygon_projected_view(g);
-  ASSERT_TRUE(v.valid());
-  EXPECT_TRUE(v.central);
-  const L ref = reference_projected_solid_angle(g.cast<L>());
-  EXPECT_NEAR(v.projected_solid_angle / ref, 1, 1e-12) << v.projected_solid_angle << " vs " << ref;
-}
-
 // A light narrower than 64 eps of its coordinates' scale is too small: V_k - x is rounded to about eps of that
 // scale, and the local polygon is rounding noise (an octagon of diameter 32 seen from 1.7e17 sampled the zenith,
 // 0.64 rad outside; fuzz_polygon_projected_double 3c4c6d32, issue 7). A 2 eps wider light is sampled.
@@ -685,8 +667,8 @@ TYPED_TEST(PolygonKernels, ALightNarrowerThanItsCoordinatesRoundingIsTooSmallFor
 
 // Sec. 3.1: a light around the zenith is central although an edge has n_z < 0 by rounding: a doubled vertex
 // (octagon 1a7607a0), a short edge whose line the coordinates do not place to the zenith's side (15bb13cf, x 5e-9
-// beside a vertex); decentral, their A_Sigma was ~1e-33 instead of 0.11 and 1.56 (fuzz_ltc_double with M = I,
-// issue 7).
+// beside a vertex), and a vertex at the zenith (below); decentral, their A_Sigma was ~1e-33 instead of 0.11 and
+// 1.56 (fuzz_ltc_double with M = I, issue 7).
 TEST(PolygonProjected, ProjectedSolidAngleMatchesLambertAroundTheZenithWithEdgesOfNoiseSign) {
   const PolygonLightGeometry<double> lights[] = {
       geom<double>({8.397054999316353, 3.442316484673952, 15.695498354587828},
@@ -708,7 +690,19 @@ TEST(PolygonProjected, ProjectedSolidAngleMatchesLambertAroundTheZenithWithEdges
                     {64.669511675834656, 2.4298803806304932, -6.6805439648799951e-16},
                     {64.901314932926539, 2.1634090301872648, 5.4550781249999991},
                     {65.4609375, 1.5200902819633486, 10.91015625},
-                    {66.020560067073461, 0.87677153373943228, 13.169723593179794}})};
+                    {66.020560067073461, 0.87677153373943228, 13.169723593179794}}),
+      // A vertex at the zenith puts the zenith on the boundary, and the central decomposition is exact: a hexagon
+      // seen from 3e-5 beside a vertex, with a vertex 8 eps from the zenith (put at it) and an edge 4e-15 long whose
+      // n_z = -1e-17 is noise. The decentral case took that edge for the only inner chain, A_Sigma 4.9e-32 instead
+      // of 0.708 (fuzz_ltc_double 403f9cc0 with M = I).
+      geom<double>({-0.1273642887492622, -10.738008116536452, 1.081344971704761},
+                   {-12.677181692463837, 47.051874731980355, 8.0928367707429203},
+                   {{0, -10.595186948776245, 0.99999999999999989},
+                    {-0.12738118791250691, -10.738008116536452, 1.0813185000471728},
+                    {-4.3530915195705404, 4.9459501274569995, 3.7789572286190678},
+                    {3.755049622491299, 14.272737943463003, -1.3971750295925287},
+                    {1.1446499483557506, -9.2562717483112031, 0.26927030274441022},
+                    {2.8899990138081828e-15, -10.595186948776242, 0.999999999999998}})};
   for (const auto& g : lights) {
     const auto v = make_polygon_projected_view(g);
     ASSERT_TRUE(v.valid());
