@@ -40,17 +40,23 @@ template <class T> bool polygon_input_finite(const PolygonLightGeometry<T>& g) {
 // fuzz_polygon_projected_double: an edge passing 4e-14 from x, whose great circle through x the coordinates
 // do not determine, issue 7). The horizon arcs of a clipped polygon lie on the exactly known horizon.
 // P: the geometry's type (T, or L for a light computed in long double, ltc.h); T: the kernel's precision.
+// Distance from x to the segment from a to a + e (e != 0), without cancellation in its interior: |p x e| / |e|.
+inline L segment_distance(const Vec3<L>& a, const Vec3<L>& e, const Vec3<L>& x) {
+  const Vec3<L> p = a - x;
+  const L ee = e.squaredNorm();
+  const L t = -p.dot(e) / ee;
+  return t <= 0 ? p.norm() : (t >= 1 ? Vec3<L>(p + e).norm() : kahan_cross<L>(p, e).norm() / std::sqrt(ee));
+}
+
 template <class P, class T = P> L polygon_kappa(const PolygonLightGeometry<P>& g, bool clipped) {
   const int n = g.light.count;
   L k = kappa_of<P, T>(g.light.vertices.data(), n, g.shading.position);
   const Vec3<L> x = g.shading.position.template cast<L>(), nl = g.shading.normal.template cast<L>();
   for (int j = 0; j < n; ++j) {
     const Vec3<L> vj = g.light.vertices[j].template cast<L>(), vj1 = g.light.vertices[(j + 1) % n].template cast<L>();
-    const Vec3<L> p = vj - x, e = vj1 - vj;
-    const L ee = e.squaredNorm();
-    if (!(ee > 0)) continue;  // a repeated vertex: covered by the vertex term
-    const L t = -p.dot(e) / ee;
-    const L seg_dist = t <= 0 ? p.norm() : (t >= 1 ? (vj1 - x).norm() : kahan_cross<L>(p, e).norm() / std::sqrt(ee));
+    const Vec3<L> e = vj1 - vj;
+    if (!(e.squaredNorm() > 0)) continue;  // a repeated vertex: covered by the vertex term
+    const L seg_dist = segment_distance(vj, e, x);
     const L mag = std::max(vj.cwiseAbs().maxCoeff(), vj1.cwiseAbs().maxCoeff()) + x.cwiseAbs().maxCoeff() +
                   kSubnormalUlps * L(std::numeric_limits<T>::min());
     k = std::max(k, seg_dist > 0 ? mag / seg_dist : std::numeric_limits<L>::infinity());
@@ -195,9 +201,7 @@ template <class T> PolygonMargins polygon_margins(const PolygonLightGeometry<T>&
         for (int i = 0; i < n; ++i) {
           const Vec3<L> a = flat.vertices[i], e = fe[i];
           inside = inside && nh.dot(kahan_cross<L>(e, Vec3<L>(foot - a))) >= 0;
-          const L ee = e.squaredNorm();
-          const L t = ee > 0 ? std::clamp(Vec3<L>(xl - a).dot(e) / ee, L(0), L(1)) : L(0);
-          dist = std::min(dist, Vec3<L>(xl - (a + t * e)).norm());
+          dist = std::min(dist, e.squaredNorm() > 0 ? segment_distance(a, e, xl) : Vec3<L>(a - xl).norm());
         }
         if (inside) dist = std::abs(height);
         const L moved = dist > 0 ? off / dist : std::numeric_limits<L>::infinity();

@@ -202,10 +202,7 @@ template <class T> void check_ltc(FuzzedDataProvider& in, const Mutation& mutate
     // the bound would be 4.2e-2, no test at all (issue 7). A_Sigma's sensitivity to the world's rounding is the
     // problem's conditioning, not the kernel's error.
     const PolygonLightGeometry<T> kt = ltc_transformed_polygon(make_polygon_view(g.polygon), view.m_inv);
-    PolygonLightGeometry<L> kt_l;
-    kt_l.shading.position = Vec3<L>::Zero(), kt_l.shading.normal = Vec3<L>(0, 0, 1);
-    kt_l.light.count = kt.light.count;
-    for (int i = 0; i < kt.light.count; ++i) kt_l.light.vertices[i] = kt.light.vertices[i].template cast<L>();
+    const PolygonLightGeometry<L> kt_l = kt.template cast<L>();
     for (int i = 0; i < ref.transformed.light.count && i < kt.light.count; ++i) {
       const Vec3<L> r = ref.transformed.light.vertices[i], k = kt_l.light.vertices[i];
       const Vec3<L> l = ref.m * r;

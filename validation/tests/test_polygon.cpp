@@ -651,7 +651,8 @@ TEST(PolygonProjected, ProjectedSolidAngleMatchesLambertWithADoubledVertexInside
 
 // A light narrower than 64 eps of its coordinates' scale is too small: V_k - x is rounded to about eps of that
 // scale, and the local polygon is rounding noise (an octagon of diameter 32 seen from 1.7e17 sampled the zenith,
-// 0.64 rad outside; fuzz_polygon_projected_double 3c4c6d32, issue 7). A 2 eps wider light is sampled.
+// 0.64 rad outside; fuzz_polygon_projected_double 3c4c6d32, issue 7). A light 8 times as wide, 8 times the bound, is
+// sampled.
 TYPED_TEST(PolygonKernels, ALightNarrowerThanItsCoordinatesRoundingIsTooSmallForTheProjectedSampler) {
   using T = TypeParam;
   const T eps = std::numeric_limits<T>::epsilon();
