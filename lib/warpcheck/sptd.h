@@ -264,7 +264,8 @@ template <class T> struct CosineCapView {
   T seg0 = 0;                  // area of the unit disk right of x0, without cancellation (make_cosine_cap_view)
   bool ellipse_only = false;   // R = E (cap entirely above the horizon)
   // The crescent with its tip at x0 in (-1, 1) (cos t < 0), where E touches the unit circle at (x0, +-c0):
-  // E's normalised abscissa tau0 = (x0 - x_c) / A there and its normalised half-height n0 = sqrt(1 - tau0^2).
+  // E's normalised abscissa tau0 = (x0 - x_c) / A there and its normalised half-height n0 = sqrt(1 - tau0^2)
+  // (both computed from c0, make_cosine_cap_view).
   bool tip = false;
   T c0 = 0, tau0 = 0, n0 = 0;
   T area = 0;                  // projected solid angle of (cap, upper hemisphere) = area of R
@@ -377,9 +378,17 @@ template <class T> CosineCapView<T> make_cosine_cap_view(const Cap<T>& cap, cons
   v.ellipse_only = v.cos_t >= T(0) && v.cos_a >= v.sin_t;
   v.tip = v.cos_t < T(0) && v.x0 > T(-1) && v.x0 < T(1);
   if (v.tip) {
+    // P0 must lie on both curves to rounding, or crescent_cdf's three terms (each ~c0 near a tip at x0 -> +-1)
+    // no longer cancel to the tip's cubic mass: c0 = sqrt(1 - x0^2) and the n0 of tau0 = (x0 - x_c) / A are each
+    // the square root of a difference within rounding of 0 there, independently stretched (found by
+    // fuzz_sptd_double 4d8f70f9: a tip at 1 + x0 = 1.1e-16, i.e. the cap's boundary tangent to the horizon at
+    // E's vertex, c0 = 1.49e-8 against sin(alpha) n0 = 1.38e-8, the area 4.7e-11 off relatively, issue 7). So
+    // n0 = c0 / sin(alpha) (E's half-height m0 = c0 at the tangency, c^2 - m^2 = 0 there, header comment) and
+    // tau0 = +-sqrt(1 - n0^2) on x0's side of x_c. The area is insensitive to where along the circle P0 then
+    // sits: moving it by d changes the mass between it and the true tip by O(d^3).
     v.c0 = std::sqrt((T(1) - v.x0) * (T(1) + v.x0));
-    v.tau0 = v.A > T(0) ? std::clamp((v.x0 - v.xc) / v.A, T(-1), T(1)) : T(1);
-    v.n0 = std::sqrt((T(1) - v.tau0) * (T(1) + v.tau0));
+    v.n0 = v.A > T(0) && v.sin_a > T(0) ? std::min(T(1), v.c0 / v.sin_a) : T(0);
+    v.tau0 = std::copysign(std::sqrt((T(1) - v.n0) * (T(1) + v.n0)), v.A > T(0) ? v.x0 - v.xc : T(1));
   }
   v.area = v.ellipse_only ? kPi<T> * v.sin_a * v.A : v.cdf(T(1));
   if (!(v.area > T(0)) || !std::isfinite(v.area)) return v.reason = NoSample::kBelowHorizon, v;

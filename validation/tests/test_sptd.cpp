@@ -412,6 +412,26 @@ TEST(SptdCaps, CosineCapAreaIsAccurateInDoubleForSmallCapsAcrossAndOnTheHorizon)
     }
 }
 
+// A crescent whose tip is within rounding of the unit circle's leftmost point (1 + x0 = 1.1e-16: g(C)'s boundary
+// tangent to the horizon at E's vertex). c0 = sqrt(1 - x0^2) and E's half-height there were computed independently,
+// each the square root of a difference within rounding of 0 (1.49e-8 against 1.38e-8), and the crescent's terms
+// did not cancel: the integral 4.7e-11 off relatively (fuzz_sptd_double 4d8f70f9, issue 7). Now within a few eps
+// of long double's; the image g(C) itself carries a few eps of the pivot transform, to which an area of ~3 is
+// not sensitive beyond O(1): 64 eps.
+TEST(SptdCaps, ClampedCosineIntegralIsAccurateWhenTheCrescentTipTouchesTheHorizonAtEsVertex) {
+  SptdCapGeometry<double> g;
+  g.sptd.pivot = Vec3<double>(0, 0.5, 0);
+  g.sptd.base = SptdBase::kClampedCosine;
+  g.sptd.base_axis = Vec3<double>(2, 0, 0);
+  g.cap = Cap<double>{Vec3<double>(0.088301988714510074, -0.99609375, 1.0005567036034595e-16), 1.99609375};
+  const auto v = make_sptd_cap_view(g);
+  const auto vl = make_sptd_cap_view(g.cast<L>());
+  ASSERT_TRUE(v.valid() && vl.valid());
+  ASSERT_TRUE(v.cosine.tip);
+  EXPECT_LE(std::abs(v.base_integral / vl.base_integral - 1), 64 * std::numeric_limits<double>::epsilon())
+      << v.base_integral << " vs " << double(vl.base_integral);
+}
+
 TEST(SptdCaps, CapIntersectionAppendixBMatchesQuadrature) {
   std::mt19937_64 g(16);
   for (int i = 0; i < 20; ++i) {
