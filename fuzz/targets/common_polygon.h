@@ -48,6 +48,29 @@ inline L segment_distance(const Vec3<L>& a, const Vec3<L>& e, const Vec3<L>& x) 
   return t <= 0 ? p.norm() : (t >= 1 ? Vec3<L>(p + e).norm() : kahan_cross<L>(p, e).norm() / std::sqrt(ee));
 }
 
+// The light's plane as the kernels flatten onto it (make_polygon_view, polygon.h): the unit area vector nh (0 for
+// zero area) and each vertex's signed distance d[k] from the plane through the centroid, in long double.
+struct PolygonLifts {
+  Vec3<L> nh = Vec3<L>::Zero();
+  L area2 = 0;  // |area vector| = 2 area
+  Vec3<L> c = Vec3<L>::Zero();  // the centroid
+  std::array<L, kMaxPolygonVertices> d{};
+};
+template <class P> PolygonLifts polygon_lifts(const PolygonLight<P>& p) {
+  PolygonLifts r;
+  const int n = p.count;
+  Vec3<L> area = Vec3<L>::Zero(), &c = r.c;
+  const Vec3<L> v0 = p.vertices[0].template cast<L>();
+  for (int i = 1; i + 1 < n; ++i)
+    area += kahan_cross<L>(Vec3<L>(p.vertices[i].template cast<L>() - v0), Vec3<L>(p.vertices[i + 1].template cast<L>() - v0));
+  for (int i = 0; i < n; ++i) c += p.vertices[i].template cast<L>() / L(n);
+  r.area2 = area.norm();
+  if (!(r.area2 > 0) || n < 3) return r;
+  r.nh = area / r.area2;
+  for (int i = 0; i < n; ++i) r.d[i] = r.nh.dot(Vec3<L>(p.vertices[i].template cast<L>() - c));
+  return r;
+}
+
 template <class P, class T = P> L polygon_kappa(const PolygonLightGeometry<P>& g, bool clipped) {
   const int n = g.light.count;
   L k = kappa_of<P, T>(g.light.vertices.data(), n, g.shading.position);
@@ -148,22 +171,17 @@ template <class T> PolygonMargins polygon_margins(const PolygonLightGeometry<T>&
       for (int i = 0; i < n; ++i) width = std::max(width, kahan_cross<L>(Vec3<L>(g.light.vertices[i].template cast<L>() - a), e).norm() / diam);
       if (width <= delta / 2) mm = std::max(mm, -arc_distance(g.light.vertices[ia], g.light.vertices[ib], g.shading.position, w));
     }
-    Vec3<L> area = Vec3<L>::Zero(), c = Vec3<L>::Zero();
-    const Vec3<L> v0 = g.light.vertices[0].template cast<L>();
-    for (int i = 1; i + 1 < n; ++i)
-      area += kahan_cross<L>(Vec3<L>(g.light.vertices[i].template cast<L>() - v0), Vec3<L>(g.light.vertices[i + 1].template cast<L>() - v0));
-    for (int i = 0; i < n; ++i) c += g.light.vertices[i].template cast<L>() / L(n);
-    const L an = area.norm();
+    const PolygonLifts lifts = polygon_lifts(g.light);
+    const L an = lifts.area2;
     if (an > 0 && n >= 3) {
-      const Vec3<L> nh = area / an;
+      const Vec3<L> nh = lifts.nh;
       PolygonLight<L> flat;
       flat.count = n;
       L off = 0;
       for (int i = 0; i < n; ++i) {
-        const Vec3<L> vi = g.light.vertices[i].template cast<L>();
-        const L d = nh.dot(Vec3<L>(vi - c));
+        const L d = lifts.d[i];
         off = std::max(off, std::abs(d));
-        flat.vertices[i] = vi - d * nh;
+        flat.vertices[i] = g.light.vertices[i].template cast<L>() - d * nh;
       }
       // The flat light's edges flat_{j+1} - flat_j = e_j - (nh.e_j) nh, e_j = V_{j+1} - V_j (the d_j differ by
       // nh.e_j), from the exact differences e_j: the difference of the rounded flat vertices leaves a short edge
@@ -193,19 +211,48 @@ template <class T> PolygonMargins polygon_margins(const PolygonLightGeometry<T>&
       // light). So dist is x's distance from the flattened polygon: from its plane where x's foot lies inside it,
       // else from its nearest edge.
       const L planarity = diam > 0 ? L(polygon_planarity_tolerance<T>(T(an / diam), T(mag))) : L(0);
+      // An edge of the light that is (nearly) along nh flattens to a remnant no longer than the non-planarity,
+      // whose direction in the plane is what is left of the cross product: the flattening can be reflex there,
+      // and that edge's plane through x then cuts the flat light's cone (found by
+      // fuzz_polygon_solid_angle_double bedd9183: an edge of 2.9e-11 along the normal of a light non-planar by
+      // 1.5e-11, flattened to 1.7e-21; x 4.4e-11 off the plane; the sample, at a vertex of the light, 1.1e-11 rad
+      // behind that remnant's plane). So flattened edges no longer than off are merged into the next one (the
+      // vertex they end at dropped, the edge vectors summed, so they stay exact), which moves the flat light by
+      // at most the merged lengths more: the credit is (off + merged) / dist, dist less the merged lengths.
       if (off > delta / 2 && off <= planarity) {
-        const L height = nh.dot(Vec3<L>(xl - c));
+        PolygonLight<L> fm;
+        std::array<Vec3<L>, kMaxPolygonVertices> fme;
+        L merged = 0;
+        int start = -1;  // a vertex whose incoming edge is kept
+        for (int i = 0; i < n && start < 0; ++i)
+          if (fe[(i + n - 1) % n].norm() > off) start = i;
+        for (int k = 0; k < n && start >= 0; ++k) {
+          const int i = (start + k) % n, prev = (i + n - 1) % n;
+          if (k > 0 && fe[prev].norm() <= off) {  // vertex i dropped: its incoming edge joins the kept one
+            merged += fe[prev].norm();
+            fme[fm.count - 1] += fe[i];
+            continue;
+          }
+          fm.vertices[fm.count] = flat.vertices[i];
+          fme[fm.count++] = fe[i];
+        }
+        const bool use_merged = fm.count >= 3 && fm.count < n;
+        const PolygonLight<L>& fl = use_merged ? fm : flat;
+        const Vec3<L>* fle = use_merged ? fme.data() : fe.data();
+        if (!use_merged) merged = 0;
+        const L height = nh.dot(Vec3<L>(xl - lifts.c));
         const Vec3<L> foot = xl - height * nh;
         bool inside = true;
         L dist = std::numeric_limits<L>::infinity();
-        for (int i = 0; i < n; ++i) {
-          const Vec3<L> a = flat.vertices[i], e = fe[i];
+        for (int i = 0; i < fl.count; ++i) {
+          const Vec3<L> a = fl.vertices[i], e = fle[i];
           inside = inside && nh.dot(kahan_cross<L>(e, Vec3<L>(foot - a))) >= 0;
           dist = std::min(dist, e.squaredNorm() > 0 ? segment_distance(a, e, xl) : Vec3<L>(a - xl).norm());
         }
         if (inside) dist = std::abs(height);
-        const L moved = dist > 0 ? off / dist : std::numeric_limits<L>::infinity();
-        mm = std::max(mm, polygon_cone_margin<L, T>(flat, xl, Vec3<L>(w.template cast<L>()), fe.data()) + moved);
+        dist -= merged;
+        const L moved = dist > 0 ? (off + merged) / dist : std::numeric_limits<L>::infinity();
+        mm = std::max(mm, polygon_cone_margin<L, T>(fl, xl, Vec3<L>(w.template cast<L>()), fle) + moved);
       }
     }
   }
