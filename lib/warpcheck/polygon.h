@@ -256,7 +256,12 @@ template <class T> struct PolygonView {
   Frame<T> frame = Frame<T>::from_z(Vec3<T>(T(0), T(0), T(1)));  // z: the shading normal
   Vec3<T> plane_normal = Vec3<T>::Zero();  // unit right-hand normal of the vertex order
   T plane_distance = 0;    // plane_normal . (V_0 - x): > 0 when the vertex order winds positively seen from x
-  LocalPolygon<T> local;   // V_k - x in the shading frame, not clipped
+  LocalPolygon<T> local;   // V_k - x in the shading frame (flattened, see lift), not clipped
+  // lift[k] = plane_normal . (V_k - x) - plane_distance: how far vertex k is off the light's plane. Where the light
+  // is non-planar beyond the offsets' rounding, `local` holds the vertices moved onto the plane, V_k - x - lift[k]
+  // plane_normal, and polygon_inward_planes the flattened light's planes (flattened = true; make_polygon_view).
+  std::array<T, kMaxPolygonVertices> lift{};
+  bool flattened = false;
   bool valid() const { return reason == NoSample::kNone; }
 };
 
@@ -299,9 +304,28 @@ PolygonView<T> make_polygon_view(const PolygonLightGeometry<T>& g, T vertex_roun
                   T(8) * std::numeric_limits<T>::epsilon() * reach;
     if ((v.plane_distance > T(0) ? -side : side) > err) return v.reason = NoSample::kEdgeOn, v;
   }
+  // check_polygon accepts a light off its plane by up to its planarity tolerance (input rounding of its coordinates,
+  // and more), and seen from x closer to the plane than a few times that, the cone of the vertices is no convex
+  // spherical polygon: each vertex moves within the plane by up to its distance from x times lift / h as seen
+  // from x (gnomonically), so the turns of the light seen from x no longer all agree, and the projected-solid-
+  // angle kernels' sector formulas break (found by fuzz_ltc_double 5692ae35: M = I, a light of size 30 at
+  // y = 3.2e9, off its plane by 6.4e-8 from the coordinates' rounding, x 24 away and 2.6e-7 off the plane:
+  // A_Sigma 1.4e-15 instead of the flattened light's 1.4e-11, issue 7). Such a light is accepted as the planar
+  // light it is near, so the kernels see that one: beyond the offsets' own rounding (8 eps reach, below which
+  // flattening would only add noise), the vertices are moved onto the plane of the area vector through the
+  // centroid, along its normal. Flattening is invisible to check_polygon's convexity test (its turns are taken
+  // along the normal) and moves each vertex by at most the non-planarity.
+  const T eps = std::numeric_limits<T>::epsilon();
+  T off = 0;
+  for (int i = 0; i < g.light.count; ++i) {
+    v.lift[i] = v.plane_normal.dot(Vec3<T>(g.light.vertices[i] - g.shading.position)) - v.plane_distance;
+    off = std::max(off, std::abs(v.lift[i]));
+  }
+  v.flattened = off > T(8) * eps * reach;
+  if (!v.flattened) v.lift.fill(T(0));
   v.local.count = g.light.count;
   for (int i = 0; i < g.light.count; ++i) {
-    Vec3<T> l = v.frame.to_local(Vec3<T>(g.light.vertices[i] - g.shading.position));
+    Vec3<T> l = v.frame.to_local(Vec3<T>(g.light.vertices[i] - g.shading.position - v.lift[i] * v.plane_normal));
     // A vertex within rounding of the horizon is on it: to_local's dot product carries an error of a few
     // eps |V - x|. Left as it is, its clip point lies a rounding error away, and the edge between them has a
     // normal made of rounding noise (found by fuzz_polygon_projected_double: samples up to 0.58 rad outside a
@@ -321,13 +345,18 @@ PolygonView<T> make_polygon_view(const PolygonLightGeometry<T>& g, T vertex_roun
 // The planes through x and the light's own edges, (V_j - x) x (V_{j+1} - V_j), oriented inwards (by the side of
 // the light x is on): a direction w is in the light's cone iff every plane's dot product with w is >= 0. From the
 // world coordinates, not from rounded directions V - x: V_{j+1} - V_j of nearby vertices is exact (Sterbenz), so
-// a short edge keeps its direction (polygon_projected.h, ltc.h). Returns the number of planes, g.light.count.
+// a short edge keeps its direction (polygon_projected.h, ltc.h). Of a flattened light (PolygonView::lift), the
+// flattened one's: vertex V_j - x - lift_j n and edge e_j - (n . e_j) n, from the exact e_j = V_{j+1} - V_j (the
+// lifts differ by n . e_j). Returns the number of planes, g.light.count.
 template <class T> int polygon_inward_planes(const PolygonLightGeometry<T>& g, const PolygonView<T>& pv, Vec3<T>* out) {
   const int n = g.light.count;
   const T orient = pv.plane_distance < T(0) ? T(-1) : T(1);
-  for (int j = 0; j < n; ++j)
-    out[j] = orient * kahan_cross(Vec3<T>(g.light.vertices[j] - g.shading.position),
-                                  Vec3<T>(g.light.vertices[(j + 1) % n] - g.light.vertices[j]));
+  const Vec3<T>& nh = pv.plane_normal;
+  for (int j = 0; j < n; ++j) {
+    Vec3<T> e = g.light.vertices[(j + 1) % n] - g.light.vertices[j];
+    if (pv.flattened) e -= nh.dot(e) * nh;
+    out[j] = orient * kahan_cross(Vec3<T>(g.light.vertices[j] - g.shading.position - pv.lift[j] * nh), e);
+  }
   return n;
 }
 

@@ -123,11 +123,9 @@ template <class T> PolygonFanView<T> make_polygon_fan_view(const PolygonLightGeo
     }
     f.inward[f.planes++] = reverse ? Vec3<T>(-pv.plane_normal) : pv.plane_normal;
   } else {
-    const int m = g.light.count;
+    // The clipped polygon is pv.local's, flattened where the light is non-planar: its planes likewise.
+    const int m = polygon_inward_planes(g, pv, f.inward.data());
     const T orient = reverse ? T(-1) : T(1);
-    for (int j = 0; j < m; ++j)
-      f.inward[j] = orient * kahan_cross(Vec3<T>(g.light.vertices[j] - g.shading.position),
-                                         Vec3<T>(g.light.vertices[(j + 1) % m] - g.light.vertices[j]));
     f.inward[m] = pv.normal;  // m <= kMaxPolygonVertices = kMaxFanVertices - 2
     f.inward[m + 1] = orient * pv.plane_normal;
     f.planes = m + 2;

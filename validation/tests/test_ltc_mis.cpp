@@ -148,6 +148,56 @@ TEST(Ltc, PdfIsPositiveAtSamplesInsideALightWithAShortEdgeOnTheHorizon) {
     }
 }
 
+// A light accepted as planar although its vertices leave the plane by far more than the offsets' rounding (here
+// 6.4e-8, the rounding of coordinates ~3.2e9), seen from 2.6e-7 off that plane and 24 away: the kernels see the
+// flattened light (make_polygon_view), whose projected solid angle Lambert's formula gives in long double. Unflattened,
+// the cone of the vertices seen from x was not convex and A_Sigma came out 1.4e-15 for 1.4e-11 (fuzz_ltc_double
+// 5692ae35, issue 7).
+TEST(Ltc, ANonPlanarLightSeenFromCloseToItsPlaneIsSampledAsItsFlattening) {
+  LtcPolygonGeometry<double> g;
+  g.polygon = PolygonLightGeometry<double>{
+      ShadingPoint<double>{{14.962579331135613, 3221225491.6532202, 11.826609910141354},
+                           {1, -6.9713964909789094e-18, 2.9531309136255907e-17}},
+      PolygonLight<double>{{-6, 3221225466, -1},
+                           {-11.993386006344959, 3221225468.2590613, 0.12953059442379922},
+                           {-6.6964465405750548, 3221225473.3351254, 2.667562801868943},
+                           {5.9021149417110728, 3221225477.4058132, 4.7029066037072571},
+                           {16.31532468053247, 3221225477.4058132, 4.7029066037072571},
+                           {16.701823351788715, 3221225473.3351254, 2.6675628018689439},
+                           {6.7705695728877586, 3221225468.2590613, 0.12953059442379988}}};
+  g.m = Mat3<double>::Identity();
+  // The flattening in long double, onto the plane of the area vector through the centroid, with x at the origin
+  // (the offsets V - x are exact; flattened world coordinates ~3.2e9 would round by 3.5e-10, 1e-3 of the height).
+  PolygonLightGeometry<L> flat = g.polygon.cast<L>();
+  const Vec3<L> x = flat.shading.position;
+  flat.shading.position = Vec3<L>::Zero();
+  for (int i = 0; i < flat.light.count; ++i) flat.light.vertices[i] -= x;
+  Vec3<L> c = Vec3<L>::Zero(), area = Vec3<L>::Zero();
+  for (int i = 0; i < flat.light.count; ++i) c += flat.light.vertices[i] / L(flat.light.count);
+  for (int i = 1; i + 1 < flat.light.count; ++i)
+    area += Vec3<L>(flat.light.vertices[i] - flat.light.vertices[0]).cross(Vec3<L>(flat.light.vertices[i + 1] - flat.light.vertices[0]));
+  const Vec3<L> nh = area.normalized();
+  L off = 0;
+  for (int i = 0; i < flat.light.count; ++i) {
+    const L d = nh.dot(Vec3<L>(flat.light.vertices[i] - c));
+    off = std::max(off, std::abs(d));
+    flat.light.vertices[i] -= d * nh;
+  }
+  ASSERT_GT(off, 5e-8L);  // the light is as non-planar as the finding's
+  const L ref = reference_projected_solid_angle(flat);
+  const auto v = make_ltc_polygon_view(g);
+  ASSERT_TRUE(v.valid());
+  // The value's own conditioning: A_Sigma is about proportional to the height 2.6e-7, known to ~eps 24 through the
+  // offsets and the normal, 2e-8 relative.
+  EXPECT_NEAR(v.integral * kPi<double> / double(ref), 1, 1e-6) << v.integral * kPi<double> << " vs " << double(ref);
+  for (const double u0 : {0.125, 0.5, 0.875})
+    for (const double u1 : {0.25, 0.5, 0.75}) {
+      const auto s = sample_ltc_polygon(v, Vec2<double>(u0, u1));
+      ASSERT_TRUE(s.valid());
+      EXPECT_NEAR(pdf_ltc_polygon(v, s.direction) / s.pdf, 1, 1e-6) << u0 << " " << u1;
+    }
+}
+
 // M^-1 P of a convex P is convex, but its computed vertices carry the rounding of the product, up to about eps
 // cond(M) of their size; check_polygon is told so (ltc.h) and accepts the transformed polygon. A square with a
 // collinear vertex on each edge under M with cond(M) up to 1e8: with only the default rounding (4 eps),
