@@ -456,7 +456,14 @@ void check_pdf_consistency_probed(T sample_pdf, const Vec3<T>& w, Pdf&& pdf, L d
 // checks see them, and to the normalising constants their view-level checks compare with a reference. The
 // libFuzzer targets and the replay use the default, kNone.
 struct Mutation {
-  enum Kind { kNone, kSamplePdfTimes1_01, kSampleDirectionNegated, kPdfTimes1_01, kNormaliserTimes1_01 } kind = kNone;
+  enum Kind {
+    kNone,
+    kSamplePdfTimes1_01,
+    kSampleDirectionNegated,
+    kPdfTimes1_01,
+    kNormaliserTimes1_01,
+    kTransformedVertexTurned  // LTC only: every vertex of the kernel's M^-1 P turned by 1e-3 rad
+  } kind = kNone;
   template <class T> DirectionSample<T> sample(DirectionSample<T> s) const {
     if (!s.valid()) return s;
     if (kind == kSamplePdfTimes1_01) s.pdf *= T(1.01);
@@ -466,6 +473,17 @@ struct Mutation {
   template <class T> T pdf(T p) const { return kind == kPdfTimes1_01 ? p * T(1.01) : p; }
   // A light's normalising constant as a family's view-level check sees it (e.g. the projected solid angle).
   template <class T> T normaliser(T x) const { return kind == kNormaliserTimes1_01 ? x * T(1.01) : x; }
+  // A vertex of a light the kernel transformed (the LTC's M^-1 P), as the family's vertex check sees it: turned
+  // by 1e-3 rad about the origin, towards the coordinate axis least aligned with it.
+  template <class T> Vec3<T> transformed_vertex(const Vec3<T>& v) const {
+    if (kind != kTransformedVertexTurned || !(v.norm() > 0)) return v;
+    Vec3<T> axis = Vec3<T>::Zero();
+    int k = 0;
+    v.cwiseAbs().minCoeff(&k);
+    axis[k] = 1;
+    const Vec3<T> t = (axis - axis.dot(v) / v.squaredNorm() * v).normalized();
+    return v + T(1e-3) * v.norm() * t;
+  }
 };
 
 }  // namespace warpcheck::fuzz

@@ -208,7 +208,7 @@ template <class T> void check_ltc(FuzzedDataProvider& in, const Mutation& mutate
     // M^-1 stretches it (the 13 corpus inputs that failed here when flattening came in, fuzz_ltc_double 5692ae35).
     const PolygonLifts lifts = polygon_lifts(g.polygon.light);
     for (int i = 0; i < ref.transformed.light.count && i < kt.light.count; ++i) {
-      const Vec3<L> r = ref.transformed.light.vertices[i], k = kt_l.light.vertices[i];
+      const Vec3<L> r = ref.transformed.light.vertices[i], k = mutate.transformed_vertex(kt_l.light.vertices[i]);
       const Vec3<L> l = ref.m * r;
       // A vertex at the shading point (length 0): the stretch is unbounded, and the check is skipped (the
       // reference divided by 0 there: UBSan, fuzz_ltc_double 5288b69a, issue 7).
