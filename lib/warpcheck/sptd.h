@@ -67,6 +67,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <numbers>
 
 #include <boost/math/tools/roots.hpp>
 
@@ -379,16 +380,29 @@ template <class T> CosineCapView<T> make_cosine_cap_view(const Cap<T>& cap, cons
   v.tip = v.cos_t < T(0) && v.x0 > T(-1) && v.x0 < T(1);
   if (v.tip) {
     // P0 must lie on both curves to rounding, or crescent_cdf's three terms (each ~c0 near a tip at x0 -> +-1)
-    // no longer cancel to the tip's cubic mass: c0 = sqrt(1 - x0^2) and the n0 of tau0 = (x0 - x_c) / A are each
-    // the square root of a difference within rounding of 0 there, independently stretched (found by
-    // fuzz_sptd_double 4d8f70f9: a tip at 1 + x0 = 1.1e-16, i.e. the cap's boundary tangent to the horizon at
-    // E's vertex, c0 = 1.49e-8 against sin(alpha) n0 = 1.38e-8, the area 4.7e-11 off relatively, issue 7). So
-    // n0 = c0 / sin(alpha) (E's half-height m0 = c0 at the tangency, c^2 - m^2 = 0 there, header comment) and
-    // tau0 = +-sqrt(1 - n0^2) on x0's side of x_c. The area is insensitive to where along the circle P0 then
-    // sits: moving it by d changes the mass between it and the true tip by O(d^3).
+    // no longer cancel to the tip's cubic mass. Of E's normalised coordinates there, tau0 = (x0 - x_c) / A and
+    // n0 = sqrt(1 - tau0^2), whichever is the smaller is taken directly and the other from it (the square root of
+    // a difference is well conditioned only for the smaller one):
+    //  * near E's vertex (|tau0| > 1/sqrt 2), n0 = c0 / sin(alpha) (E's half-height m0 = c0 at the tangency,
+    //    c^2 - m^2 = 0 there, header comment), c0 = sqrt(1 - x0^2), and tau0 = +-sqrt(1 - n0^2) on x0's side of
+    //    x_c. From x0 - x_c instead, n0 was the square root of a difference within rounding of 0 (found by
+    //    fuzz_sptd_double 4d8f70f9: a tip at 1 + x0 = 1.1e-16, the cap's boundary tangent to the horizon at E's
+    //    vertex, c0 = 1.49e-8 against sin(alpha) n0 = 1.38e-8, the area 4.7e-11 off relatively, issue 7);
+    //  * elsewhere tau0 = (x0 - x_c) / A and n0 from it. From c0 / sin(alpha) instead, tau0 was the square root of
+    //    1 - n0^2 with n0 within rounding of 1 (found by fuzz_sptd_double bd9360f1 and 9219e2fc: a near-hemisphere
+    //    image cap with x0 - x_c = 2.8e-14 resp. 1.5e-10, tau0 off by up to sqrt(eps); the area 2.1e-8 resp.
+    //    4.1e-10 off relatively; both passed before the first branch was applied everywhere, issue 7).
+    // The area is insensitive to where along the circle P0 then sits: moving it by d changes the mass between it
+    // and the true tip by O(d^3).
     v.c0 = std::sqrt((T(1) - v.x0) * (T(1) + v.x0));
-    v.n0 = v.A > T(0) && v.sin_a > T(0) ? std::min(T(1), v.c0 / v.sin_a) : T(0);
-    v.tau0 = std::copysign(std::sqrt((T(1) - v.n0) * (T(1) + v.n0)), v.A > T(0) ? v.x0 - v.xc : T(1));
+    const T tau_x = v.A > T(0) ? std::clamp((v.x0 - v.xc) / v.A, T(-1), T(1)) : T(1);
+    if (std::abs(tau_x) <= std::numbers::sqrt2_v<T> / T(2)) {
+      v.tau0 = tau_x;
+      v.n0 = std::sqrt((T(1) - v.tau0) * (T(1) + v.tau0));
+    } else {
+      v.n0 = v.A > T(0) && v.sin_a > T(0) ? std::min(T(1), v.c0 / v.sin_a) : T(0);
+      v.tau0 = std::copysign(std::sqrt((T(1) - v.n0) * (T(1) + v.n0)), tau_x);
+    }
   }
   v.area = v.ellipse_only ? kPi<T> * v.sin_a * v.A : v.cdf(T(1));
   if (!(v.area > T(0)) || !std::isfinite(v.area)) return v.reason = NoSample::kBelowHorizon, v;

@@ -432,6 +432,30 @@ TEST(SptdCaps, ClampedCosineIntegralIsAccurateWhenTheCrescentTipTouchesTheHorizo
       << v.base_integral << " vs " << double(vl.base_integral);
 }
 
+// The same crescent's tip near E's top instead (x0 - x_c within rounding of 0: g(C) a near-hemisphere, 1 - cos =
+// 1 - d). Taking n0 = c0 / sin(alpha) there made tau0 = sqrt(1 - n0^2) the square root of a difference within
+// rounding of 0 (fuzz_sptd_double bd9360f1, 9219e2fc: the area 2.1e-8 resp. 4.1e-10 off relatively, issue 7).
+// Reference: the projected solid angle of a hemisphere at angle t from n is (pi / 2)(1 + cos t) (Lambert's formula
+// for the lune), and dP/dalpha = sin(alpha) times the cosine integral over the boundary circle = 2 sin t there, so
+// P = (pi / 2)(1 + cos t) - 2 sin t asin(d) + O(d^2) (cos alpha = d; O(d^2) < 1e-19 for d <= 1e-10). Tolerance as
+// in CosineCapAreaIsAccurateInDoubleForSmallCapsAcrossAndOnTheHorizon: the abscissae carry a few eps, R's area
+// moves by its height 2 sin(alpha) per unit of abscissa. Measured: within 18 eps (t = 2.9, d = 8.2e-14); on
+// ce4c71c up to 2.9e9 eps.
+TEST(SptdCaps, ClampedCosineIntegralIsAccurateWhenTheCrescentTipIsNearEsTop) {
+  const double e = std::numeric_limits<double>::epsilon();
+  for (double t : {2.1331, 1.6162, 2.9})
+    for (double d : {8.2e-14, 1e-10}) {
+      const Vec3<double> axis(std::sin(t), 0, std::cos(t));
+      const double omc = 1 - d, exact_d = 1 - omc;  // 1 - omc is exact (Sterbenz)
+      const auto v = make_cosine_cap_view(Cap<double>{axis, omc}, Vec3<double>(0, 0, 1));
+      ASSERT_TRUE(v.valid() && v.tip) << t << " " << d;
+      const L n = axis.cast<L>().norm(), cos_t = L(axis.z()) / n, sin_t = L(axis.x()) / n;
+      const L ref = std::numbers::pi_v<L> / 2 * (1 + cos_t) - 2 * sin_t * std::asin(L(exact_d));
+      const L tol = 8 * e * 2 / ref + 16 * e;
+      EXPECT_LE(std::abs(v.area / ref - 1), tol) << "t " << t << " d " << d << ": " << v.area << " vs " << double(ref);
+    }
+}
+
 TEST(SptdCaps, CapIntersectionAppendixBMatchesQuadrature) {
   std::mt19937_64 g(16);
   for (int i = 0; i < 20; ++i) {
