@@ -320,7 +320,19 @@ template <class T> ProjectedCapView<T> make_projected_cap_view(const SphereLight
   const Vec3<T> horizontal = p.z.cross(Vec3<T>(wd.cross(p.z)));
   p.h = std::clamp(h_raw, T(-1), T(1));
   p.w_dx = horizontal.stableNorm();
-  p.x = p.w_dx > T(0) ? Vec3<T>(horizontal / p.w_dx) : Frame<T>::from_z(p.z).x;  // overhead: any horizontal x
+  // x from the horizontal part scaled to [1/2, 1) by a power of two: exact, so x is bit for bit horizontal / w_dx
+  // for a normal horizontal part. A subnormal one carries few significant bits: (t, t, 0) with t = denorm_min has
+  // the rounded norm t, and x came out (1, 1, 0), of length sqrt 2 (found by fuzz_projected_cap_double 613804bc:
+  // a light overhead to 1e-318, w_d and n with subnormal horizontal components, sampled 0.11 rad outside its
+  // cap, issue 7).
+  if (p.w_dx > T(0)) {
+    int ex = 0;
+    std::frexp(horizontal.cwiseAbs().maxCoeff(), &ex);
+    const Vec3<T> scaled(std::ldexp(horizontal.x(), -ex), std::ldexp(horizontal.y(), -ex), std::ldexp(horizontal.z(), -ex));
+    p.x = scaled / scaled.stableNorm();
+  } else {
+    p.x = Frame<T>::from_z(p.z).x;  // overhead: any horizontal x
+  }
   p.y = p.z.cross(p.x);
   p.r_y = std::sqrt(s.sin2_theta_max);
   p.v = s.cos_theta_max;

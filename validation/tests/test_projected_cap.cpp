@@ -431,6 +431,32 @@ TEST(ProjectedCapScale, SubnormalAndHugeLightsSampleExactlyLikeTheSameLightAtUni
   EXPECT_GT(cases_seen[1] * cases_seen[2] * cases_seen[3], 0);
 }
 
+// A light overhead to far below rounding, the horizontal parts of w_d and n subnormal (fuzz_projected_cap_double
+// 613804bc, issue 7): x was the subnormal horizontal part over its rounded norm, (1, 1, 0) of length sqrt 2, and
+// every sample off the axis 0.11 rad outside the cap (0.41 rad from the axis against theta_max 0.298, measured on
+// ce4c71c). Geometry as the fuzzer decoded it.
+TEST(ProjectedCapScale, ALightOverheadToASubnormalHorizontalPartIsSampledInsideItsCap) {
+  const double e = std::numeric_limits<double>::epsilon();
+  SphereLightGeometry<double> g;
+  g.light.center = Vec3<double>(1.0000000031710769e-30, 1.0000000031710769e-30, 0.5);
+  g.light.radius = 3.0454106285624994e+287;
+  g.shading.position = Vec3<double>(2.0000000063421537e-30, 2.0000000063421537e-30, -1.0373429953541013e+288);
+  g.shading.normal = Vec3<double>(-1.0000000063421537e-60, -1.0000000063421537e-60, 1.0373429986435956e+258);
+  const ProjectedCapView<double> v = make_projected_cap_view(g);
+  ASSERT_TRUE(v.valid());
+  EXPECT_NEAR(v.x.norm(), 1, 4 * e);
+  const long double theta_max = std::asin(3.0454106285624994e+287L / 1.0373429953541013e+288L);
+  for (double u0 : {0.0, 0.3, 0.7, 1.0})
+    for (double u1 : {0.0, 0.25, 0.5, 0.999}) {
+      const auto s = sample_projected_spherical_cap<double>(v, Vec2<double>(u0, u1));
+      ASSERT_TRUE(s.valid()) << u0 << " " << u1;
+      // the cap's axis is +z to 1e-318
+      const long double angle = std::acos(std::min(1.0L, (long double)s.direction.z() / s.direction.cast<long double>().norm()));
+      // samples at u0 = 0, 1 lie on the rim: a few eps of the kernel's rounding, times 1 / sin(theta_max) = 3.4 in acos
+      EXPECT_LE(angle, theta_max + 1e-12L) << u0 << " " << u1;
+    }
+}
+
 TEST(ProjectedCapCase3, SamplePdfsKeepTheirDigitsNearTheLunesFlatSide) {
   // fuzz_projected_cap_double 71f5a077 (issue 7): a cap of 90 deg - 0.02 deg (r / d = 1 - 2^-24, v = 3.45e-4; r^2
   // is exact in double, so the double and long double views agree to rounding) with its centre just below the
