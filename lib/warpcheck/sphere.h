@@ -126,6 +126,11 @@ template <class T> DirectionSample<T> sample_sphere_visible_area(const SphereVie
   // p - x = d z + r m, m = (sin_a cos phi, sin_a sin phi, -cos_a).
   const Vec3<T> local(r * sin_a * std::cos(phi), r * sin_a * std::sin(phi), d - r * cos_a);
   const T dist = local.stableNorm();
+  // |p - x| beyond the largest finite T (a light of radius ~1e308): the density dist^3 / ... is not representable
+  // either, so there is no sample; checked before local / dist, which would be 0 and its renormalisation a
+  // division by zero (found by fuzz_sphere_double cf221826, UBSan, issue 7; the sample was already discarded, as its
+  // pdf was Inf).
+  if (!std::isfinite(dist)) return DirectionSample<T>::none(NoSample::kTooSmall);
   // cos_light * dist = -m.(p - x) = d cos_a - r = (d - r)(1 - u0): exact algebra, no cancellation.
   const T cos_light_times_dist = (d - r) * (T(1) - u[0]);
   if (!(cos_light_times_dist > T(0))) return DirectionSample<T>::none(NoSample::kOnSilhouette);
