@@ -131,10 +131,12 @@ template <class T> L arc_distance(const Vec3<T>& a, const Vec3<T>& b, const Vec3
   return d;
 }
 
-// Signed angular margins of w inside the light (clipped: also above the shading horizon): `inner` against the
-// light as given, `outer` the larger of that and the margin against merge_short_edges(light). A sample must lie
-// inside some accepted displacement of the light (outer >= -tol); a density of 0 needs w near the boundary of
-// some accepted displacement (inner <= tol).
+// Signed angular margins of w inside the light (clipped: also above the shading horizon): `outer` the largest over
+// the light as given and its accepted displacements (merge_short_edges(light), a sliver's arc, the flat light, the
+// flat light merged, the flattened light with its credit; below), `inner` the smallest over the light as given, the
+// largest of the displacements' margins, and, off the plane beyond delta / 2, the flat light's own margin without
+// credit (80cce1ce below). A sample must lie inside some accepted displacement of the light (outer >= -tol); a
+// density of 0 needs w near the boundary of some accepted displacement (inner <= tol).
 struct PolygonMargins {
   L inner, outer;
 };
@@ -142,6 +144,7 @@ template <class T> PolygonMargins polygon_margins(const PolygonLightGeometry<T>&
   L m = polygon_cone_margin(g.light, g.shading.position, w);
   const PolygonLight<T> merged = merge_short_edges(g.light, g.shading.position);
   L mm = m;
+  L flat_margin = std::numeric_limits<L>::infinity();  // the flat light's, without credit: an `inner` candidate
   if (merged.count >= 3 && merged.count < g.light.count) mm = polygon_cone_margin(merged, g.shading.position, w);
   // Merged down to a segment or a point: the light is within delta of it, so the accepted displacements' cones
   // are within the tolerance of its arc (a polygon of width 6 and length 1e30: a sliver).
@@ -193,8 +196,58 @@ template <class T> PolygonMargins polygon_margins(const PolygonLightGeometry<T>&
         const Vec3<L> ei = g.light.vertices[(i + 1) % n].template cast<L>() - g.light.vertices[i].template cast<L>();
         fe[i] = ei - nh.dot(ei) * nh;
       }
-      if (off > 0 && off <= delta / 2)
-        mm = std::max(mm, polygon_cone_margin<L, T>(flat, xl, Vec3<L>(w.template cast<L>()), fe.data()));
+      const Vec3<L> wl = w.template cast<L>();
+      // The flat light itself, without credit, beyond delta / 2 off the plane: there every kernel flattens (delta / 2
+      // = 32 eps (|V|_inf + |x|_inf) exceeds make_polygon_view's 8 eps reach) and its density tests w against the
+      // flat light's planes (polygon_inward_planes), so a density of 0 is expected within tol of that boundary, which
+      // can lie up to off / dist inside the light as given. The flat light is an accepted displacement, so its margin
+      // is one of `inner`'s candidates (the returned minimum); only `outer` credits the move (below). This excuses a
+      // density of 0 at a sample inside the light as given but more than tol outside the flat one, which outer,
+      // accepting both, does not flag either: a sampler that strays from its own flattened light by less than the
+      // credit is not detected here. (Found by fuzz_ltc_double 80cce1ce with M = I: a quad with two vertices at
+      // 4.4e12, non-planar by 0.31 (check_polygon's planarity tolerance, 8 sqrt(eps) of its width 3.1e12, is 3.7e5),
+      // x 0.31 off its plane, 1.9e5 from its near vertices and 1.3e5 from its edges V0 V1 and V2 V3: the kernel
+      // flattened it, and its own sample lay 1e-10 rad outside the flat light's plane of edge V0 V1 (within the
+      // kernel's rounding, tol 1.4e-6), pdf 0 there and at the probes, 2.3e-6 rad inside the light as given;
+      // flattening turns that edge's plane by up to 0.31 / 1.3e5 = 2.4e-6 rad. issue 7.) Below delta / 2 the flat
+      // light is within the budget of the light as given and enters outer only.
+      const L planarity = diam > 0 ? L(polygon_planarity_tolerance<T>(T(an / diam), T(mag))) : L(0);
+      if (off > delta / 2 && off <= planarity) flat_margin = polygon_cone_margin<L, T>(flat, xl, wl, fe.data());
+      if (off > 0 && off <= delta / 2) {
+        mm = std::max(mm, polygon_cone_margin<L, T>(flat, xl, wl, fe.data()));
+        // The flat light with its short edges merged. Seen from x at a height h above the plane, an edge e whose
+        // direction leaves the plane by the coordinates' rounding (nh.e / |e|, up to eps |V| / |e|) has a plane
+        // through x tilted against the flat edge's by about (nh.e / |e|) dist / h, which can cut the light, and
+        // flattening removes that; an edge shorter still has a direction in the plane of rounding noise too and can
+        // be reflex, and merging removes that: each of the two displacements repairs one of them, and neither alone
+        // the light (found by fuzz_ltc_double 026c1719 with M = I: an octagon non-planar by 4.2e-16, x 2.5e-7 off its
+        // plane; its edge V0 V1 of 1.7e-10 leaves the plane by 3.8e-17, so its plane through x cut 4.4e-8 rad into
+        // the light at V3, and the sample on the edge V3 V4 lay 4.9e-8 rad behind it; the flat light has V7, 3.1e-15
+        // from V0, reflex by 2.7 rad, and that edge's plane lay 1.7e-7 rad behind the sample; the flat light with V7
+        // merged into V0 contains it, margin +8.7e-17; issue 7). A vertex within r = delta / 2 - off of the last kept
+        // one (the wrapped-around tail: of vertex 0, as merge_short_edges) is dropped, i.e. moved onto that vertex's
+        // flat position, by at most r + off = delta / 2, the budget of each displacement above; a kept vertex moves
+        // by its |d_k| <= off. The merged edges are sums of the exact flat edges fe.
+        const L r = delta / 2 - off;
+        std::array<bool, kMaxPolygonVertices> kept{};
+        int last = 0;
+        kept[0] = true;
+        for (int i = 1; i < n; ++i) {
+          kept[i] = (g.light.vertices[i].template cast<L>() - g.light.vertices[last].template cast<L>()).norm() > r;
+          if (kept[i]) last = i;
+        }
+        for (int i = n - 1; i > 0; --i) {
+          if (!((g.light.vertices[i].template cast<L>() - g.light.vertices[0].template cast<L>()).norm() <= r)) break;
+          kept[i] = false;
+        }
+        PolygonLight<L> fm;
+        std::array<Vec3<L>, kMaxPolygonVertices> fme;
+        for (int i = 0; i < n; ++i) {
+          if (kept[i]) fm.vertices[fm.count] = flat.vertices[i], fme[fm.count++] = Vec3<L>::Zero();
+          fme[fm.count - 1] += fe[i];  // vertex 0 is kept: fm.count >= 1
+        }
+        if (fm.count >= 3 && fm.count < n) mm = std::max(mm, polygon_cone_margin<L, T>(fm, xl, wl, fme.data()));
+      }
       // A light farther off its plane than that, but within check_polygon's planarity tolerance, is accepted as
       // the planar light it is near (polygon_planarity_tolerance, polygon.h; every kernel takes its side and its
       // edge-on test from the area vector), and its directions are known only up to its non-planarity: the angle
@@ -210,7 +263,6 @@ template <class T> PolygonMargins polygon_margins(const PolygonLightGeometry<T>&
       // sample at a horizon clip point 1.5 from x with the vertices ~5.6 away, 6.6e-12 rad outside the flattened
       // light). So dist is x's distance from the flattened polygon: from its plane where x's foot lies inside it,
       // else from its nearest edge.
-      const L planarity = diam > 0 ? L(polygon_planarity_tolerance<T>(T(an / diam), T(mag))) : L(0);
       // An edge of the light that is (nearly) along nh flattens to a remnant no longer than the non-planarity,
       // whose direction in the plane is what is left of the cross product: the flattening can be reflex there,
       // and that edge's plane through x then cuts the flat light's cone (found by
@@ -258,9 +310,9 @@ template <class T> PolygonMargins polygon_margins(const PolygonLightGeometry<T>&
   }
   if (clipped) {
     const L h = g.shading.normal.template cast<L>().normalized().dot(w.template cast<L>().normalized());
-    m = std::min(m, h), mm = std::min(mm, h);
+    m = std::min(m, h), mm = std::min(mm, h), flat_margin = std::min(flat_margin, h);
   }
-  return {std::min(m, mm), std::max(m, mm)};
+  return {std::min({m, mm, flat_margin}), std::max(m, mm)};
 }
 
 template <class T, class Sample, class Pdf>
