@@ -134,7 +134,8 @@ template <class T> L arc_distance(const Vec3<T>& a, const Vec3<T>& b, const Vec3
 // Signed angular margins of w inside the light (clipped: also above the shading horizon): `inner` against the
 // light as given, `outer` the larger of that and the margin against merge_short_edges(light). A sample must lie
 // inside some accepted displacement of the light (outer >= -tol); a density of 0 needs w near the boundary of
-// some accepted displacement (inner <= tol).
+// some accepted displacement (inner <= tol). `inner` also comes down to the flattened light's margin less its
+// credit (below), as a flattened light's boundary is as good as the given one's.
 struct PolygonMargins {
   L inner, outer;
 };
@@ -142,6 +143,7 @@ template <class T> PolygonMargins polygon_margins(const PolygonLightGeometry<T>&
   L m = polygon_cone_margin(g.light, g.shading.position, w);
   const PolygonLight<T> merged = merge_short_edges(g.light, g.shading.position);
   L mm = m;
+  L lo = m;  // the smallest margin against an accepted displacement that only `inner` takes (below)
   if (merged.count >= 3 && merged.count < g.light.count) mm = polygon_cone_margin(merged, g.shading.position, w);
   // Merged down to a segment or a point: the light is within delta of it, so the accepted displacements' cones
   // are within the tolerance of its arc (a polygon of width 6 and length 1e30: a sliver).
@@ -252,15 +254,26 @@ template <class T> PolygonMargins polygon_margins(const PolygonLightGeometry<T>&
         if (inside) dist = std::abs(height);
         dist -= merged;
         const L moved = dist > 0 ? (off + merged) / dist : std::numeric_limits<L>::infinity();
-        mm = std::max(mm, polygon_cone_margin<L, T>(fl, xl, Vec3<L>(w.template cast<L>()), fle) + moved);
+        const L flat_margin = polygon_cone_margin<L, T>(fl, xl, Vec3<L>(w.template cast<L>()), fle);
+        mm = std::max(mm, flat_margin + moved);
+        // The same accepted displacements bound `inner` from below: a density of 0 is allowed near the boundary of
+        // any of them, and the credit above takes them as the cones whose great circles lie within `moved` of the
+        // flat light's, so inner may come down to flat_margin - moved (the outer credit, from the other side). The
+        // kernels sample and test the flattened light (make_polygon_view), and their samples on its boundary (a
+        // fan vertex at u = (0, 0)) get pdf() 0 from the planes through that vertex by rounding; measured against
+        // the light as given, such a sample is inside by up to the angle flattening moved it (found by
+        // fuzz_polygon_solid_angle_double e9b7708c: vertex 0 1.5e-11 off the plane y = 0 of the others, lifts
+        // +-3.7e-12, x 1 above the plane; the sample at the flattened vertex V3, 7.3e-13 rad inside the light as
+        // given (tol 1.4e-13), -1e-16 against the flat light's planes through V3, moved 3.7e-12; issue 7).
+        lo = std::min(lo, flat_margin - moved);
       }
     }
   }
   if (clipped) {
     const L h = g.shading.normal.template cast<L>().normalized().dot(w.template cast<L>().normalized());
-    m = std::min(m, h), mm = std::min(mm, h);
+    m = std::min(m, h), mm = std::min(mm, h), lo = std::min(lo, h);
   }
-  return {std::min(m, mm), std::max(m, mm)};
+  return {std::min({m, mm, lo}), std::max(m, mm)};
 }
 
 template <class T, class Sample, class Pdf>
