@@ -576,6 +576,54 @@ TEST(PolygonSolidAngle, ALongStripWhoseVerticesAreNearlyAntipodalSeenFromX) {
   }
 }
 
+// The class of 2a3027c9: random convex strips 0.5..5.5 wide and 1..1e14 long in the plane z = 0, seen from up to 10
+// off the plane near their middle, random normals. Before the split of wide fan edges (polygon_solid_angle.h, on
+// e03f31c), 12056 samples of a 17 x 17 grid (plain and clipped, 569 lights) lay outside by more than 64 eps kappa,
+// and the solid angle was off by up to a factor 134; now none, and within 6.1e-14 of Girard's (where that exceeds
+// 1e-6 sr; below, Girard's formula in long double loses its digits).
+TEST(PolygonSolidAngle, LongStripsSeenFromCloseByKeepTheirSolidAngleAndTheirSamples) {
+  using T = double;
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> U(0, 1);
+  const L eps = std::numeric_limits<T>::epsilon();
+  double worst_rel = 0;
+  int lights = 0, outside = 0;
+  for (int trial = 0; trial < 600; ++trial) {
+    const int m = 3 + trial % 6;
+    const double len = std::pow(10.0, 14 * U(rng)), wid = 0.5 + 5 * U(rng);
+    std::vector<double> phase(m);
+    for (double& p : phase) p = U(rng) * 2 * 3.14159265358979;
+    std::sort(phase.begin(), phase.end());
+    PolygonLightGeometry<T> g;
+    g.light.count = m;
+    for (int i = 0; i < m; ++i) g.light.vertices[i] = Vec3<T>(wid * std::sin(phase[i]), len * std::cos(phase[i]), 0);
+    g.shading.position = Vec3<T>(wid * (U(rng) - 0.5) * 3, len * (U(rng) - 0.5) * 1e-3, (U(rng) - 0.5) * 20);
+    g.shading.normal = Vec3<T>(U(rng) - 0.5, U(rng) - 0.5, U(rng) - 0.5).normalized();
+    if (check_polygon(g.light) != NoSample::kNone) continue;
+    const auto v = make_polygon_solid_angle_view(g, false);
+    if (!v.valid()) continue;
+    ++lights;
+    const L omega = girard_solid_angle(g);
+    if (omega > 1e-6) worst_rel = std::max(worst_rel, double(std::abs(v.solid_angle / omega - 1)));
+    for (const bool clipped : {false, true}) {
+      const auto vc = make_polygon_solid_angle_view(g, clipped);
+      if (!vc.valid()) continue;
+      const L tol = 64 * eps * cone_conditioning(g, clipped);
+      for (int i = 0; i <= 16; ++i)
+        for (int j = 0; j <= 16; ++j) {
+          const Vec2<T> u(std::min(T(i) / 16, std::nextafter(T(1), T(0))), std::min(T(j) / 16, std::nextafter(T(1), T(0))));
+          const DirectionSample<T> s = sample_polygon_solid_angle(vc, u);
+          if (s.valid() && cone_margin(g, s.direction, clipped) < -tol) ++outside;
+        }
+    }
+  }
+  EXPECT_GT(lights, 500);
+  EXPECT_EQ(outside, 0);
+  EXPECT_LT(worst_rel, 1e-11);
+  std::printf("[ double ] %d long strips: %d samples outside, worst relative solid-angle error %.2g\n", lights, outside,
+              worst_rel);
+}
+
 // check_polygon's planarity tolerance is relative to the polygon's width (8 sqrt(eps) of it, plus the
 // coordinates' rounding), and a polygon narrower than that tolerance is rejected: its plane is undetermined.
 TYPED_TEST(PolygonKernels, ThinPolygonsArePlanarRelativeToTheirWidth) {
