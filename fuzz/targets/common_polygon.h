@@ -135,7 +135,7 @@ template <class T> L arc_distance(const Vec3<T>& a, const Vec3<T>& b, const Vec3
 // the light as given and its accepted displacements (merge_short_edges(light), a sliver's arc, the flat light, the
 // flat light merged, the flattened light with its credit; below), `inner` the smallest over the light as given, the
 // largest of the displacements' margins, and, off the plane beyond delta / 2, the flat light's own margin without
-// credit (80cce1ce below). A sample must lie inside some accepted displacement of the light (outer >= -tol); a
+// credit (80cce1ce below), and the flattened light's margin less its credit (e9b7708c below). A sample must lie inside some accepted displacement of the light (outer >= -tol); a
 // density of 0 needs w near the boundary of some accepted displacement (inner <= tol).
 struct PolygonMargins {
   L inner, outer;
@@ -145,6 +145,7 @@ template <class T> PolygonMargins polygon_margins(const PolygonLightGeometry<T>&
   const PolygonLight<T> merged = merge_short_edges(g.light, g.shading.position);
   L mm = m;
   L flat_margin = std::numeric_limits<L>::infinity();  // the flat light's, without credit: an `inner` candidate
+  L lo = m;  // the smallest margin against an accepted displacement that only `inner` takes (below)
   if (merged.count >= 3 && merged.count < g.light.count) mm = polygon_cone_margin(merged, g.shading.position, w);
   // Merged down to a segment or a point: the light is within delta of it, so the accepted displacements' cones
   // are within the tolerance of its arc (a polygon of width 6 and length 1e30: a sliver).
@@ -304,15 +305,26 @@ template <class T> PolygonMargins polygon_margins(const PolygonLightGeometry<T>&
         if (inside) dist = std::abs(height);
         dist -= merged;
         const L moved = dist > 0 ? (off + merged) / dist : std::numeric_limits<L>::infinity();
-        mm = std::max(mm, polygon_cone_margin<L, T>(fl, xl, Vec3<L>(w.template cast<L>()), fle) + moved);
+        const L fl_margin = polygon_cone_margin<L, T>(fl, xl, Vec3<L>(w.template cast<L>()), fle);
+        mm = std::max(mm, fl_margin + moved);
+        // The same accepted displacements bound `inner` from below: a density of 0 is allowed near the boundary of
+        // any of them, and the credit above takes them as the cones whose great circles lie within `moved` of the
+        // flat light's, so inner may come down to fl_margin - moved (the outer credit, from the other side). The
+        // kernels sample and test the flattened light (make_polygon_view), and their samples on its boundary (a
+        // fan vertex at u = (0, 0)) get pdf() 0 from the planes through that vertex by rounding; measured against
+        // the light as given, such a sample is inside by up to the angle flattening moved it (found by
+        // fuzz_polygon_solid_angle_double e9b7708c: vertex 0 1.5e-11 off the plane y = 0 of the others, lifts
+        // +-3.7e-12, x 1 above the plane; the sample at the flattened vertex V3, 7.3e-13 rad inside the light as
+        // given (tol 1.4e-13), -1e-16 against the flat light's planes through V3, moved 3.7e-12; issue 7).
+        lo = std::min(lo, fl_margin - moved);
       }
     }
   }
   if (clipped) {
     const L h = g.shading.normal.template cast<L>().normalized().dot(w.template cast<L>().normalized());
-    m = std::min(m, h), mm = std::min(mm, h), flat_margin = std::min(flat_margin, h);
+    m = std::min(m, h), mm = std::min(mm, h), flat_margin = std::min(flat_margin, h), lo = std::min(lo, h);
   }
-  return {std::min({m, mm, flat_margin}), std::max(m, mm)};
+  return {std::min({m, mm, flat_margin, lo}), std::max(m, mm)};
 }
 
 template <class T, class Sample, class Pdf>

@@ -28,8 +28,9 @@ namespace warpcheck {
 inline constexpr int kMaxPolygonVertices = 8;
 // Clipping a convex polygon to a half-space adds at most one vertex.
 inline constexpr int kMaxClippedVertices = kMaxPolygonVertices + 1;
-// The solid-angle fan of a clipped polygon may add one more: the midpoint of a horizon edge (polygon_solid_angle.h).
-inline constexpr int kMaxFanVertices = kMaxClippedVertices + 1;
+// The solid-angle fan adds the midpoint of a horizon edge wider than 90 degrees and of every edge wider than 120 degrees
+// (polygon_solid_angle.h): a convex spherical polygon's perimeter is at most 2 pi, so at most three in all.
+inline constexpr int kMaxFanVertices = kMaxClippedVertices + 3;
 
 template <class T> struct PolygonLight {
   std::array<Vec3<T>, kMaxPolygonVertices> vertices{};

@@ -49,7 +49,10 @@ template <class T> Vec3<T> unit_difference(const Vec3<T>& pa, T na, const Vec3<T
   return (e - (pa / na) * dn) / nb;
 }
 
-template <class T> PolygonFanView<T> make_polygon_fan_view(const PolygonLightGeometry<T>& g, bool clipped) {
+// split_wide_edges (Section 5's sampler, make_polygon_solid_angle_view): every edge of the fan wider than 120 degrees
+// gets its midpoint as an extra vertex, and the fan is rooted at the first (see the end of this function).
+template <class T> PolygonFanView<T> make_polygon_fan_view(const PolygonLightGeometry<T>& g, bool clipped,
+                                                          bool split_wide_edges = false) {
   PolygonFanView<T> f;
   const PolygonView<T> pv = make_polygon_view(g);
   if (!pv.valid()) return f.reason = pv.reason, f;
@@ -59,6 +62,7 @@ template <class T> PolygonFanView<T> make_polygon_fan_view(const PolygonLightGeo
   for (int i = 0; i < pv.local.count; ++i) above = above || pv.local.v[i].z() > T(0);
   if (!above) return f.reason = NoSample::kBelowHorizon, f;
   const bool reverse = pv.plane_distance < T(0);
+  bool horizon_rooted = false;  // the clipped fan is rooted at a horizon edge's midpoint
   if (!clipped) {
     const int m = g.light.count;
     f.count = m;
@@ -99,7 +103,7 @@ template <class T> PolygonFanView<T> make_polygon_fan_view(const PolygonLightGeo
       if (!(ua.dot(ub) < T(0))) continue;
       Vec3<T> mid = safe_normalized(Vec3<T>(ua.y() - ub.y(), ub.x() - ua.x(), T(0)));
       if (light_normal.dot(mid) * pv.plane_distance < T(0)) mid = -mid;
-      if (!mid.isZero()) root = nq, q[nq++] = mid * ((a.norm() + b.norm()) / T(2));
+      if (!mid.isZero()) root = nq, q[nq++] = mid * ((a.norm() + b.norm()) / T(2)), horizon_rooted = true;
     }
     f.count = nq;
     for (int k = 0; k < nq; ++k) f.p[k] = pv.frame.to_world(q[reverse ? (root - k + nq) % nq : (root + k) % nq]);
@@ -130,6 +134,57 @@ template <class T> PolygonFanView<T> make_polygon_fan_view(const PolygonLightGeo
     f.inward[m + 1] = orient * pv.plane_normal;
     f.planes = m + 2;
   }
+  if (split_wide_edges) {
+    // An edge wider than 120 degrees gets its midpoint, and the fan is rooted at the first such midpoint (unless
+    // the clipped fan is already rooted at a horizon edge's). Eq. 13 and the sampler's G1, G2 take sums of unit
+    // vectors, and a fan triangle with two nearly antipodal vertices has 1 + u0.uk + u0.uk1 + uk.uk1 = G1 + G2 as
+    // the difference of two numbers near 2 (or a G1 = uk1 . (u0 + uk) whose u0 + uk lost its component along
+    // u0 to rounding), when the triangle's true denominator is as small as the square of the vertices' offsets
+    // from antipodal. That happens for a long light seen from close by, whose vertices all lie near two
+    // antipodal directions (found by fuzz_polygon_solid_angle_double 2a3027c9: a strip 6 wide and 3.9e11 long
+    // seen from 8 off its plane, all seven vertices within 2.5e-10 rad of +-y; the fan triangle (V0, V1, V2)
+    // with V0, V1 near +y and V2 near -y had G1 + G2 = -2 + 2 = 0 instead of ~1e-20, area pi; solid angle
+    // 3.748 instead of 0.686 (Girard's formula from the edge planes, long double), and 3339 of a 65 x 65 grid of
+    // samples outside the light, up to 0.0215 rad; issue 7). The light's edges between the two clusters are the
+    // wide ones: rooted at the midpoint of one, no fan triangle has two nearly antipodal vertices. (120 degrees,
+    // not 90: the horizon midpoint's edges are 90 degrees wide up to rounding, and need no split.) The midpoint of
+    // the edge from u_a to u_b on the great circle of normal m (m . u_a = m . u_b = 0 up to rounding, m pointing
+    // into the cone) is m x (u_a - u_b) (= u_a + u_b up to scale when m = u_a x u_b,
+    // without cancellation for nearly antipodal ends, like the horizon's midpoint above); m is the edge plane of
+    // the cone that holds both ends best: the fan's edges lie on the light's edge planes and on the horizon
+    // (the cone's last plane, the light's own, is not an edge). A convex spherical polygon has a perimeter of at
+    // most 2 pi, so it has at most two edges wider than 120 degrees (kMaxFanVertices, polygon.h).
+    std::array<Vec3<T>, kMaxFanVertices> q;
+    int nq = 0, root = -1;
+    for (int k = 0; k < f.count; ++k) {
+      const int k1 = (k + 1) % f.count;
+      q[nq++] = f.p[k];
+      if (!(f.u[k].dot(f.u[k1]) < T(-0.5)) || nq + (f.count - 1 - k) >= kMaxFanVertices) continue;
+      int best = -1;
+      T best_residual = std::numeric_limits<T>::infinity();
+      for (int j = 0; j + 1 < f.planes; ++j) {
+        const Vec3<T> mj = safe_normalized(f.inward[j]);
+        const T r = std::max(std::abs(mj.dot(f.u[k])), std::abs(mj.dot(f.u[k1])));
+        if (r < best_residual) best_residual = r, best = j;
+      }
+      if (best < 0) continue;
+      const Vec3<T> mid = safe_normalized(kahan_cross(safe_normalized(f.inward[best]), Vec3<T>(f.u[k] - f.u[k1])));
+      if (mid.isZero()) continue;
+      if (root < 0) root = nq;
+      q[nq++] = mid * ((f.len[k] + f.len[k1]) / T(2));
+    }
+    if (nq > f.count) {
+      if (horizon_rooted || root < 0) root = 0;
+      for (int k = 0; k < nq; ++k) f.p[k] = q[(root + k) % nq];
+      f.count = nq;
+      for (int k = 0; k < f.count; ++k) {
+        f.e[k] = f.p[k] - f.p[0];
+        f.u[k] = safe_normalized(f.p[k]);
+        f.len[k] = f.p[k].stableNorm();
+        if (f.u[k].isZero()) return f.reason = NoSample::kNonFinite, f;
+      }
+    }
+  }
   return f;
 }
 
@@ -156,7 +211,7 @@ template <class T> struct PolygonSolidAngleView {
 template <class T> PolygonSolidAngleView<T> make_polygon_solid_angle_view(const PolygonLightGeometry<T>& g,
                                                                           bool clipped = false) {
   PolygonSolidAngleView<T> v;
-  v.fan = make_polygon_fan_view(g, clipped);
+  v.fan = make_polygon_fan_view(g, clipped, /*split_wide_edges=*/true);
   if (!v.fan.valid()) return v.reason = v.fan.reason, v;
   const auto& f = v.fan;
   for (int k = 1; k + 1 < f.count; ++k) {
