@@ -144,8 +144,9 @@ template <class T> PolygonMargins polygon_margins(const PolygonLightGeometry<T>&
   L m = polygon_cone_margin(g.light, g.shading.position, w);
   const PolygonLight<T> merged = merge_short_edges(g.light, g.shading.position);
   L mm = m;
-  L flat_margin = std::numeric_limits<L>::infinity();  // the flat light's, without credit: an `inner` candidate
-  L lo = m;  // the smallest margin against an accepted displacement that only `inner` takes (below)
+  // The smallest margin against an accepted displacement that only `inner` takes: the flat light's without credit
+  // (80cce1ce) and with its credit subtracted (e9b7708c), below.
+  L lo = std::numeric_limits<L>::infinity();
   if (merged.count >= 3 && merged.count < g.light.count) mm = polygon_cone_margin(merged, g.shading.position, w);
   // Merged down to a segment or a point: the light is within delta of it, so the accepted displacements' cones
   // are within the tolerance of its arc (a polygon of width 6 and length 1e30: a sliver).
@@ -213,7 +214,7 @@ template <class T> PolygonMargins polygon_margins(const PolygonLightGeometry<T>&
       // flattening turns that edge's plane by up to 0.31 / 1.3e5 = 2.4e-6 rad. issue 7.) Below delta / 2 the flat
       // light is within the budget of the light as given and enters outer only.
       const L planarity = diam > 0 ? L(polygon_planarity_tolerance<T>(T(an / diam), T(mag))) : L(0);
-      if (off > delta / 2 && off <= planarity) flat_margin = polygon_cone_margin<L, T>(flat, xl, wl, fe.data());
+      if (off > delta / 2 && off <= planarity) lo = std::min(lo, polygon_cone_margin<L, T>(flat, xl, wl, fe.data()));
       if (off > 0 && off <= delta / 2) {
         mm = std::max(mm, polygon_cone_margin<L, T>(flat, xl, wl, fe.data()));
         // The flat light with its short edges merged. Seen from x at a height h above the plane, an edge e whose
@@ -322,9 +323,9 @@ template <class T> PolygonMargins polygon_margins(const PolygonLightGeometry<T>&
   }
   if (clipped) {
     const L h = g.shading.normal.template cast<L>().normalized().dot(w.template cast<L>().normalized());
-    m = std::min(m, h), mm = std::min(mm, h), flat_margin = std::min(flat_margin, h), lo = std::min(lo, h);
+    m = std::min(m, h), mm = std::min(mm, h);  // inner <= m <= h already: lo needs no clamp
   }
-  return {std::min({m, mm, flat_margin, lo}), std::max(m, mm)};
+  return {std::min({m, mm, lo}), std::max(m, mm)};
 }
 
 template <class T, class Sample, class Pdf>
