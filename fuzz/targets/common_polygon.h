@@ -131,6 +131,27 @@ template <class T> L arc_distance(const Vec3<T>& a, const Vec3<T>& b, const Vec3
   return d;
 }
 
+// The flat light (vertices `flat`, exact edges fe_i = flat_{i+1} - flat_i) with the vertices not `kept` dropped:
+// a dropped vertex's outgoing edge joins the last kept vertex's, so the merged edges are sums of exact edges.
+// Used by both merges of the flattened light in polygon_margins, which differ only in which vertices they keep.
+struct FlatMerge {
+  PolygonLight<L> light;
+  std::array<Vec3<L>, kMaxPolygonVertices> edges;
+};
+inline FlatMerge merge_flat_vertices(const PolygonLight<L>& flat, const std::array<Vec3<L>, kMaxPolygonVertices>& fe,
+                                     const std::array<bool, kMaxPolygonVertices>& kept) {
+  FlatMerge r;
+  const int n = flat.count;
+  int first = 0;
+  while (first < n && !kept[first]) ++first;
+  for (int k = 0; k < n && first < n; ++k) {
+    const int i = (first + k) % n;
+    if (kept[i]) r.light.vertices[r.light.count] = flat.vertices[i], r.edges[r.light.count++] = Vec3<L>::Zero();
+    r.edges[r.light.count - 1] += fe[i];
+  }
+  return r;
+}
+
 // Signed angular margins of w inside the light (clipped: also above the shading horizon): `outer` the largest over
 // the light as given and its accepted displacements (merge_short_edges(light), a sliver's arc, the flat light, the
 // flat light merged, the flattened light with its credit; below), `inner` the smallest over the light as given, the
@@ -231,24 +252,27 @@ template <class T> PolygonMargins polygon_margins(const PolygonLightGeometry<T>&
         // flat position, by at most r + off = delta / 2, the budget of each displacement above; a kept vertex moves
         // by its |d_k| <= off. The merged edges are sums of the exact flat edges fe.
         const L r = delta / 2 - off;
+        // Measured between the vertices as given or between their flat positions (flat_i - flat_last, the sum of
+        // the exact flat edges between them): either bounds the move by r + off. The flat distance catches an edge
+        // longer than r that flattening shortens below it (found by fuzz_polygon_solid_angle_double 4a059601: an
+        // edge V2 V3 of 1.2e-10 along the normal of a light non-planar by 2.9e-11, r 1e-11, flattened to ~7e-21
+        // and reflex; x 7700 away; the flat light's plane of that edge cut 1.6e-6 rad into the light, and the
+        // sample, on the edge V0 V1, lay behind it; with V3 merged into V2 it is inside by 8e-15 rad; issue 7).
+        auto within_r = [&](int i, int j) {  // vertices i and j, j before i going around, within r
+          Vec3<L> f = Vec3<L>::Zero();
+          for (int k = j; k != i; k = (k + 1) % n) f += fe[k];
+          return (g.light.vertices[i].template cast<L>() - g.light.vertices[j].template cast<L>()).norm() <= r || f.norm() <= r;
+        };
         std::array<bool, kMaxPolygonVertices> kept{};
         int last = 0;
         kept[0] = true;
         for (int i = 1; i < n; ++i) {
-          kept[i] = (g.light.vertices[i].template cast<L>() - g.light.vertices[last].template cast<L>()).norm() > r;
+          kept[i] = !within_r(i, last);
           if (kept[i]) last = i;
         }
-        for (int i = n - 1; i > 0; --i) {
-          if (!((g.light.vertices[i].template cast<L>() - g.light.vertices[0].template cast<L>()).norm() <= r)) break;
-          kept[i] = false;
-        }
-        PolygonLight<L> fm;
-        std::array<Vec3<L>, kMaxPolygonVertices> fme;
-        for (int i = 0; i < n; ++i) {
-          if (kept[i]) fm.vertices[fm.count] = flat.vertices[i], fme[fm.count++] = Vec3<L>::Zero();
-          fme[fm.count - 1] += fe[i];  // vertex 0 is kept: fm.count >= 1
-        }
-        if (fm.count >= 3 && fm.count < n) mm = std::max(mm, polygon_cone_margin<L, T>(fm, xl, wl, fme.data()));
+        for (int i = n - 1; i > 0 && within_r(0, i); --i) kept[i] = false;
+        const FlatMerge fm = merge_flat_vertices(flat, fe, kept);
+        if (fm.light.count >= 3 && fm.light.count < n) mm = std::max(mm, polygon_cone_margin<L, T>(fm.light, xl, wl, fm.edges.data()));
       }
       // A light farther off its plane than that, but within check_polygon's planarity tolerance, is accepted as
       // the planar light it is near (polygon_planarity_tolerance, polygon.h; every kernel takes its side and its
@@ -274,25 +298,17 @@ template <class T> PolygonMargins polygon_margins(const PolygonLightGeometry<T>&
       // vertex they end at dropped, the edge vectors summed, so they stay exact), which moves the flat light by
       // at most the merged lengths more: the credit is (off + merged) / dist, dist less the merged lengths.
       if (off > delta / 2 && off <= planarity) {
-        PolygonLight<L> fm;
-        std::array<Vec3<L>, kMaxPolygonVertices> fme;
+        std::array<bool, kMaxPolygonVertices> kept{};
         L merged = 0;
-        int start = -1;  // a vertex whose incoming edge is kept
-        for (int i = 0; i < n && start < 0; ++i)
-          if (fe[(i + n - 1) % n].norm() > off) start = i;
-        for (int k = 0; k < n && start >= 0; ++k) {
-          const int i = (start + k) % n, prev = (i + n - 1) % n;
-          if (k > 0 && fe[prev].norm() <= off) {  // vertex i dropped: its incoming edge joins the kept one
-            merged += fe[prev].norm();
-            fme[fm.count - 1] += fe[i];
-            continue;
-          }
-          fm.vertices[fm.count] = flat.vertices[i];
-          fme[fm.count++] = fe[i];
+        for (int i = 0; i < n; ++i) {
+          const L incoming = fe[(i + n - 1) % n].norm();
+          kept[i] = incoming > off;
+          if (!kept[i]) merged += incoming;
         }
-        const bool use_merged = fm.count >= 3 && fm.count < n;
-        const PolygonLight<L>& fl = use_merged ? fm : flat;
-        const Vec3<L>* fle = use_merged ? fme.data() : fe.data();
+        const FlatMerge fm = merge_flat_vertices(flat, fe, kept);
+        const bool use_merged = fm.light.count >= 3 && fm.light.count < n;
+        const PolygonLight<L>& fl = use_merged ? fm.light : flat;
+        const Vec3<L>* fle = use_merged ? fm.edges.data() : fe.data();
         if (!use_merged) merged = 0;
         const L height = nh.dot(Vec3<L>(xl - lifts.c));
         const Vec3<L> foot = xl - height * nh;
