@@ -28,8 +28,9 @@
 // arithmetic itself adds a few tens of ulps. We therefore accept a direction as inside the light when its
 // angular distance to the light's boundary (measured conservatively: the distance to every bounding great
 // circle, resp. the ray's miss distance over d for a sphere) is at most
-//     tol = kTolUlps * eps_T * kappa,   kappa = 1 + max_k (|V_k|_inf + |x|_inf + 16 min_T) / |V_k - x|
-// (for a sphere, V is the centre and |V - x| = d, kappa = 1 + (|c|_inf + |x|_inf) / d), kTolUlps = 64.
+//     tol = kTolUlps * eps_T * kappa,   kappa = max(1, max_k (|V_k|_inf + |x|_inf + 16 min_T) / |V_k - x|)
+// (for a sphere, V is the centre and |V - x| = d, kappa = max(1, (|c|_inf + |x|_inf) / d)), kTolUlps = 64. (Until
+// 2026-12-03 this comment said 1 + max_k; the code has always taken the larger of the two, the stricter.)
 // kappa grows without bound for a shading point close to a vertex relative to the coordinates' magnitude: that
 // is exactly when the input coordinates themselves no longer determine the direction. The reference is
 // computed in long double from the exact T inputs (exact conversion; the edge normals by Kahan's
@@ -306,7 +307,7 @@ template <class T> L eps() { return L(std::numeric_limits<T>::epsilon()); }
 // kSubnormalUlps min_T to the magnitudes in kappa.
 inline constexpr long double kSubnormalUlps = 16;
 
-// kappa = 1 + max_k (|V_k|_inf + |x|_inf + kSubnormalUlps min_T) / |V_k - x| over the given points (see the
+// kappa = max(1, max_k (|V_k|_inf + |x|_inf + kSubnormalUlps min_T) / |V_k - x|) over the given points (see the
 // header comment). P: the points' type (T, or L for points computed in long double); T: the kernel's precision.
 // subnormal_ulps: kSubnormalUlps, or 0 for a kernel that rescales V - x by a power of two before any other
 // arithmetic (no subnormal intermediate from the coordinates' magnitude; the caller derives it).

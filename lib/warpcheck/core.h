@@ -133,6 +133,11 @@ template <class T> T cube_root(T x) {
   return std::cbrt(x);
 }
 
+// v * 2^e, exact componentwise (std::ldexp) unless a component over- or underflows.
+template <class T> Vec3<T> ldexp(const Vec3<T>& v, int e) {
+  return Vec3<T>(std::ldexp(v.x(), e), std::ldexp(v.y(), e), std::ldexp(v.z(), e));
+}
+
 // Renormalises a direction that is a unit vector up to rounding (a sampler's output): one division and three
 // products instead of Eigen's normalized(), which divides each component (three divisions; measured 3 of the
 // top 4 instructions of the float projected-cap sample under perf). Not for vectors that may be 0 or huge.

@@ -168,8 +168,18 @@ template <class T> PolygonFanView<T> make_polygon_fan_view(const PolygonLightGeo
         if (r < best_residual) best_residual = r, best = j;
       }
       if (best < 0) continue;
-      const Vec3<T> mid = safe_normalized(kahan_cross(safe_normalized(f.inward[best]), Vec3<T>(f.u[k] - f.u[k1])));
+      Vec3<T> mid = safe_normalized(kahan_cross(safe_normalized(f.inward[best]), Vec3<T>(f.u[k] - f.u[k1])));
       if (mid.isZero()) continue;
+      // Two planes can hold both ends equally well: a sliver's two long edges lie on one great circle with opposite
+      // inward normals, and the other edge's normal gives the antipode of the midpoint (found by
+      // fuzz_polygon_solid_angle_double c8680af4: a triangle 3.3 long and ~6e-14 wide seen from 0.84, its two
+      // 146-degree edges split at antipodal "midpoints"; solid angle 6.26 instead of ~6e-17 sr, samples 0.7 rad
+      // outside; issue 7). The midpoint lies on the short arc, mid . (u_a + u_b) > 0, and on the light's side of
+      // the plane through x parallel to the light (the cone's last plane), like every direction of the light: its
+      // sign from whichever of the two is larger (u_a + u_b is rounding noise for nearly antipodal ends, the
+      // light's side for x close to its plane).
+      const T by_arc = mid.dot(Vec3<T>(f.u[k] + f.u[k1])), by_side = mid.dot(safe_normalized(f.inward[f.planes - 1]));
+      if ((std::abs(by_arc) >= std::abs(by_side) ? by_arc : by_side) < T(0)) mid = -mid;
       if (root < 0) root = nq;
       q[nq++] = mid * ((f.len[k] + f.len[k1]) / T(2));
     }

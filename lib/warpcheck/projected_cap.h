@@ -285,7 +285,7 @@ template <class T> int unit_scale_geometry(const SphereLightGeometry<T>& g, Sphe
   std::frexp(m, &e);
   std::frexp(r, &er);  // r < 2^er
   out.shading.position = Vec3<T>::Zero();
-  out.light.center = Vec3<T>(std::ldexp(d.x(), -e), std::ldexp(d.y(), -e), std::ldexp(d.z(), -e));
+  out.light.center = ldexp(d, -e);
   out.light.radius = er - e > 2 ? T(4) : std::max(std::ldexp(r, -e), std::numeric_limits<T>::denorm_min());
   return e;
 }
@@ -328,7 +328,7 @@ template <class T> ProjectedCapView<T> make_projected_cap_view(const SphereLight
   if (p.w_dx > T(0)) {
     int ex = 0;
     std::frexp(horizontal.cwiseAbs().maxCoeff(), &ex);
-    const Vec3<T> scaled(std::ldexp(horizontal.x(), -ex), std::ldexp(horizontal.y(), -ex), std::ldexp(horizontal.z(), -ex));
+    const Vec3<T> scaled = ldexp(horizontal, -ex);
     p.x = scaled / scaled.stableNorm();
   } else {
     p.x = Frame<T>::from_z(p.z).x;  // overhead: any horizontal x

@@ -576,6 +576,47 @@ TEST(PolygonSolidAngle, ALongStripWhoseVerticesAreNearlyAntipodalSeenFromX) {
   }
 }
 
+// A sliver triangle 3.3 long and ~6e-14 wide, seen from 0.84 (fuzz_polygon_solid_angle_double c8680af4, the recorded
+// geometry): its two long edges are 146 degrees wide and lie on one great circle with opposite inward normals, so
+// the fan split of make_polygon_fan_view, taking the midpoint's great circle from whichever edge plane held both
+// ends best, put one edge's midpoint at the other's antipode. The double view then had a solid angle of 6.26 sr
+// (the sliver's is ~6e-17: long double gives 5.9e-17) and its samples lay up to 0.7 rad off the sliver's arc. Now the
+// split midpoints of both edges agree, and the double view's solid angle is at most 1e-15 sr or it declines.
+TEST(PolygonSolidAngle, ASliversTwoLongEdgesOnOneGreatCircleAreSplitAtTheSameMidpoint) {
+  PolygonLightGeometry<double> g;
+  g.light = PolygonLight<double>{{1, -2, 1},
+                                 {0.99999999999998557, -2.0000000000000147, 0.99999999999994216},
+                                 {-1.350949136089209, 1.3028556096171042, -2.7499917986505222}};
+  g.shading.position = Vec3<double>(0, -0.0, -2.4556366520970824e-13);
+  g.shading.normal = Vec3<double>(0.37155708794077913, -0.20912644562062288, 0.90455041879546594);
+  ASSERT_EQ(check_polygon(g.light), NoSample::kNone);
+  const auto fan = make_polygon_fan_view(g, false, /*split_wide_edges=*/true);
+  ASSERT_EQ(fan.count, 5);  // V0 V1 V2 plus the two midpoints
+  for (int a = 0; a < fan.count; ++a)
+    for (int b = a + 1; b < fan.count; ++b)
+      EXPECT_GT(fan.u[a].dot(fan.u[b]), -0.9) << "fan vertices " << a << " and " << b << " nearly antipodal";
+  const auto v = make_polygon_solid_angle_view(g, false);
+  if (v.valid()) EXPECT_LE(v.solid_angle, 1e-15);
+  // In long double the sliver has a solid angle, and its samples lie on the arc from V2 to V0.
+  PolygonLightGeometry<L> gl;
+  gl.light.count = 3;
+  for (int i = 0; i < 3; ++i) gl.light.vertices[i] = g.light.vertices[i].cast<L>();
+  gl.shading.position = g.shading.position.cast<L>();
+  gl.shading.normal = g.shading.normal.cast<L>();
+  const auto vl = make_polygon_solid_angle_view(gl, false);
+  ASSERT_TRUE(vl.valid());
+  EXPECT_LT(vl.solid_angle, L(1e-15));
+  const Vec3<L> ua = (gl.light.vertices[2] - gl.shading.position).normalized(), ub = (gl.light.vertices[0] - gl.shading.position).normalized();
+  const Vec3<L> arc = ua.cross(ub).normalized();
+  for (double u0 : {0.0, 0.25, 0.5, 0.75, 0.999})
+    for (double u1 : {0.0, 0.5, 0.999}) {
+      const DirectionSample<L> s = sample_polygon_solid_angle(vl, Vec2<L>(L(u0), L(u1)));
+      ASSERT_TRUE(s.valid());
+      EXPECT_LT(std::abs(arc.dot(s.direction)), L(1e-12)) << "u " << u0 << " " << u1;  // on the great circle
+      EXPECT_GT(s.direction.dot(ua + ub), L(0)) << "u " << u0 << " " << u1;           // on the short arc
+    }
+}
+
 // The class of 2a3027c9: random convex strips 0.5..5.5 wide and 1..1e14 long in the plane z = 0, seen from up to 10
 // off the plane near their middle, random normals. Before the split of wide fan edges (polygon_solid_angle.h, on
 // e03f31c), 12056 samples of a 17 x 17 grid (plain and clipped, 569 lights) lay outside by more than 64 eps kappa,
