@@ -120,6 +120,21 @@ template <class T> T polygon_planarity_tolerance(T width, T magnitude) {
   return T(8) * std::sqrt(eps) * width + T(64) * eps * magnitude;
 }
 
+// An edge e = V_j+1 - V_j in the plane of unit normal nhat: its projection onto the plane, scaled by a power of two
+// (exact) so that its largest entry is in [1/2, 1), and err (the rounding of its ends, delta_j + delta_j+1) scaled
+// alike. Unscaled, the squares in the length of an edge shorter than sqrt(denorm_min) (1.5e-162 in double)
+// underflow to 0, and the cross products with an edge a few denorm_min long have a direction quantised to the
+// subnormal grid (a plane 0.08 rad off, fuzz_polygon_projected_double a5885e87...; issue 7). Returns false when the
+// projection is no longer than err: the edge is a point in the plane up to rounding, and has no direction there.
+template <class T> bool edge_in_plane(const Vec3<T>& e, T err, const Vec3<T>& nhat, Vec3<T>& scaled, T& scaled_err) {
+  int scale = 0;
+  std::frexp(e.cwiseAbs().maxCoeff(), &scale);
+  const Vec3<T> es = ldexp(e, -scale);
+  scaled = es - nhat.dot(es) * nhat;
+  scaled_err = std::ldexp(err, -scale);
+  return scaled.norm() > scaled_err;
+}
+
 // kNone for a valid light; otherwise kNonFinite, kZeroSize or kInvalidGeometry, with a message if asked.
 // vertex_rounding: each vertex V_k is known to vertex_rounding |V_k|_inf (a caller that computed the vertices,
 // such as ltc.h's M^-1 P, passes its own bound).
@@ -167,51 +182,73 @@ NoSample check_polygon(const PolygonLight<T>& p, std::string* message = nullptr,
       return fail(NoSample::kInvalidGeometry, "vertices are not coplanar");
   // Convexity: every turn goes the same way as the area vector, and the turns add up to one revolution
   // (rejects star polygons such as a pentagram, whose turns all agree but add up to two).
+  //
+  // The turns are taken between consecutive edges whose projection onto the plane is longer than their ends'
+  // rounding. An edge within rounding of a point (in the plane) has no direction there, and its two turns are
+  // rounding noise: the turn that counts is the one between its neighbours, which dropping it joins into one (the
+  // sum stays a multiple of 2 pi). Testing every vertex's own two edges instead let a reflex turn hide behind such
+  // an edge: a denorm_min edge along the normal between (16, 0) and (4, 0.5) in a clockwise pentagon
+  // (fuzz_polygon_projected_double c42d6431..., a biased sample 0.016 rad outside), and a reflex corner of 90
+  // degrees at the origin of the pentagon (-1, 0) (0, -1) (0.5, 0) (0, 2) (0, 0) in the plane x = 0, behind an edge
+  // along x and two edges 1e-307 long (fuzz_polygon_solid_angle_double 641e4492..., a clipped sample 0.26 rad
+  // outside; issue 7). Dropping such an edge also lets the turning sum of a polygon wound twice count two
+  // revolutions where the edge's own turns, underflowed to 0, made it one (fuzz_polygon_solid_angle_double
+  // b6ebf498..., test APolygonWoundTwiceWithASubnormalEdgeIsNotSimple).
+  // Each edge is scaled by a power of two (edge_in_plane) before its length in the plane and its turns are taken:
+  // unscaled, the squares in the length of an edge shorter than sqrt(denorm_min) underflowed to 0, so a real edge
+  // 1e15 times longer than its rounding was dropped, and the reflex turn of a notch made of such edges went unseen
+  // (test AReflexNotchOfEdgesShorterThanTheSquareRootOf...); and the cross and dot products of two kept edges 1e-160
+  // long would underflow to 0, a turn of atan2(0, 0) = 0. Scaling changes neither a turn's angle nor the tests
+  // below, whose bounds are scaled alike.
+  //
   // A reflex turn is forgiven only as far as the input's rounding explains it. Vertex k is known to
-  // delta_k = vertex_rounding |V_k|_inf, so a = V_i - V_{i-1} is off by at most delta_{i-1} + delta_i, b by
-  // delta_i + delta_{i+1}, and s = nhat . (a x b) by |a| err_b + |b| err_a + err_a err_b. Not the planarity
-  // tolerance: that one is a length, so an edge shorter than it could point anywhere, and every kernel's
-  // inside test (the planes through x and each edge, polygon_inward_planes) would then cut a slice off the
-  // light that its sampler still samples: pdf() 0 at its own samples (fuzz_ltc_double a8864f7e..., d3e18c5b...,
-  // 1e7d91f3...: edges of length 7.5e-9 to 8 reflex by up to 0.8 rad in lights of diameter 16 to 1e14; issue 7).
+  // delta_k = vertex_rounding |V_k|_inf, so an edge from V_j to V_j+1 is off by at most delta_j + delta_j+1, and
+  // s = nhat . (a x b) of two edges a, b by |a| err_b + |b| err_a + err_a err_b. Not the planarity tolerance: that
+  // one is a length, so an edge shorter than it could point anywhere, and every kernel's inside test (the planes
+  // through x and each edge, polygon_inward_planes) would then cut a slice off the light that its sampler still
+  // samples: pdf() 0 at its own samples (fuzz_ltc_double a8864f7e..., d3e18c5b..., 1e7d91f3...: edges of length
+  // 7.5e-9 to 8 reflex by up to 0.8 rad in lights of diameter 16 to 1e14; issue 7).
   auto rounding = [&](int k) { return vertex_rounding * p.vertices[(k + p.count) % p.count].cwiseAbs().maxCoeff(); };
+  // A spike: b runs back along a, the computed turn atan2(s, c) is within rounding of +-pi, and which of the two it
+  // is depends on the sign of a rounding error in s (the kernels' edge planes use the exact differences a and b,
+  // and s from kahan_cross is accurate to a few eps |a| |b|). The turning sum can still come to one revolution and
+  // the reflex turn next to it can be within the vertices' rounding (an edge an ulp long), so the spike passed as
+  // convex, and the plane through the reversed edge faced outwards in every kernel (found by
+  // fuzz_polygon_projected_double da03856c... and fuzz_polygon_solid_angle_double 3091f781..., issue 7). No convex
+  // polygon turns by pi (an interior angle of 0). Not measured against the vertices' rounding: a short edge after a
+  // long one is exact (Sterbenz) and turns by what it says (a collinear vertex an ulp before a corner turns by
+  // 3 pi / 4 with |s| = |c| = eps), and M^-1 P under an ill-conditioned M (ltc.h) is a legitimate needle whose ends
+  // turn by pi - 1e-8. Tested at every vertex, short edges included (the kernels have a plane for each edge), and
+  // again between the kept edges below.
+  auto is_spike = [&](const Vec3<T>& a, const Vec3<T>& b, T s) {
+    return a.dot(b) < T(0) && std::abs(s) <= T(8) * eps * a.norm() * b.norm();
+  };
   for (int i = 0; i < p.count; ++i) {
     const Vec3<T> a = p.vertices[i] - p.vertices[(i + p.count - 1) % p.count];
     const Vec3<T> b = p.vertices[(i + 1) % p.count] - p.vertices[i];
-    const T s = nhat.dot(kahan_cross<T>(a, b)), c = a.dot(b);
-    const T err_a = rounding(i - 1) + rounding(i), err_b = rounding(i) + rounding(i + 1);
-    const T s_err = a.norm() * err_b + b.norm() * err_a + err_a * err_b;
-    if (s < -s_err) return fail(NoSample::kInvalidGeometry, "polygon is not convex");
-    // A spike: b runs back along a, the computed turn atan2(s, c) is within rounding of +-pi, and which of the two
-    // it is depends on the sign of a rounding error in s (the kernels' edge planes use the exact differences a and
-    // b, and s from kahan_cross is accurate to a few eps |a| |b|). The turning sum can still come to one
-    // revolution and the reflex turn next to it can be within the vertices' rounding (an edge an ulp long), so the
-    // spike passed as convex, and the plane through the reversed edge faced outwards in every kernel (found by
-    // fuzz_polygon_projected_double da03856c... and fuzz_polygon_solid_angle_double 3091f781..., issue 7). No
-    // convex polygon turns by pi (an interior angle of 0). Not measured against the vertices' rounding: a short
-    // edge after a long one is exact (Sterbenz) and turns by what it says (a collinear vertex an ulp before a
-    // corner turns by 3 pi / 4 with |s| = |c| = eps), and M^-1 P under an ill-conditioned M (ltc.h) is a
-    // legitimate needle whose ends turn by pi - 1e-8.
-    if (c < T(0) && std::abs(s) <= T(8) * eps * a.norm() * b.norm())
+    if (is_spike(a, b, nhat.dot(kahan_cross<T>(a, b))))
       return fail(NoSample::kInvalidGeometry, "polygon is not convex (a spike)");
   }
-  // The turning number, over the edges whose projection onto the plane is longer than their ends' rounding. An
-  // edge within rounding of a point (in the plane) has no direction there: its turns atan2(s, c) with both products
-  // underflowing or rounding to 0 came out as 0 instead of the turn they share, and a polygon wound twice (eight
-  // vertices in the plane x = 0 with subnormal x, one edge 9e-308 long along x) summed to one revolution and
-  // passed as simple (found by fuzz_polygon_solid_angle_double b6ebf498..., a sample 0.16 rad outside; issue 7).
-  // Dropping such an edge joins its neighbours' turns into one, which keeps the sum a multiple of 2 pi.
-  std::array<Vec3<T>, kMaxPolygonVertices> kept;
+  struct KeptEdge {
+    Vec3<T> e;  // V_j+1 - V_j in the plane, scaled by a power of two (edge_in_plane)
+    T err;      // its rounding bound delta_j + delta_j+1, scaled alike
+  };
+  std::array<KeptEdge, kMaxPolygonVertices> kept;
   int nk = 0;
   for (int i = 0; i < p.count; ++i) {
     const Vec3<T> e = p.vertices[(i + 1) % p.count] - p.vertices[i];
-    if (Vec3<T>(e - nhat.dot(e) * nhat).norm() > rounding(i) + rounding(i + 1)) kept[nk++] = e;
+    KeptEdge k;
+    if (edge_in_plane<T>(e, rounding(i) + rounding(i + 1), nhat, k.e, k.err)) kept[nk++] = k;
   }
   if (nk < 3) return fail(NoSample::kZeroSize, "fewer than three edges longer than their rounding");
   T turning = 0;
   for (int i = 0; i < nk; ++i) {
-    const Vec3<T>&a = kept[(i + nk - 1) % nk], &b = kept[i];
-    turning += std::atan2(nhat.dot(kahan_cross<T>(a, b)), a.dot(b));
+    const KeptEdge &ka = kept[(i + nk - 1) % nk], &kb = kept[i];
+    const T s = nhat.dot(kahan_cross<T>(ka.e, kb.e)), c = ka.e.dot(kb.e);
+    const T s_err = ka.e.norm() * kb.err + kb.e.norm() * ka.err + ka.err * kb.err;
+    if (s < -s_err) return fail(NoSample::kInvalidGeometry, "polygon is not convex");
+    if (is_spike(ka.e, kb.e, s)) return fail(NoSample::kInvalidGeometry, "polygon is not convex (a spike)");
+    turning += std::atan2(s, c);
   }
   if (std::abs(turning - kTwoPi<T>) > T(0.5)) return fail(NoSample::kInvalidGeometry, "polygon is not simple");
   if (message) message->clear();
@@ -263,6 +300,7 @@ template <class T> struct PolygonView {
   // plane_normal, and polygon_inward_planes the flattened light's planes (flattened = true; make_polygon_view).
   std::array<T, kMaxPolygonVertices> lift{};
   bool flattened = false;
+  T vertex_rounding = kPolygonVertexRounding<T>;  // as passed to check_polygon (make_polygon_view)
   bool valid() const { return reason == NoSample::kNone; }
 };
 
@@ -272,6 +310,7 @@ template <class T> struct PolygonView {
 template <class T>
 PolygonView<T> make_polygon_view(const PolygonLightGeometry<T>& g, T vertex_rounding = kPolygonVertexRounding<T>) {
   PolygonView<T> v;
+  v.vertex_rounding = vertex_rounding;
   if (!all_finite(g.shading.position)) return v.reason = NoSample::kNonFinite, v;
   if (!all_finite(g.shading.normal)) return v.reason = NoSample::kNonFinite, v;
   if (const NoSample r = check_polygon(g.light, nullptr, vertex_rounding); r != NoSample::kNone) return v.reason = r, v;
@@ -346,17 +385,33 @@ PolygonView<T> make_polygon_view(const PolygonLightGeometry<T>& g, T vertex_roun
 // The planes through x and the light's own edges, (V_j - x) x (V_{j+1} - V_j), oriented inwards (by the side of
 // the light x is on): a direction w is in the light's cone iff every plane's dot product with w is >= 0. From the
 // world coordinates, not from rounded directions V - x: V_{j+1} - V_j of nearby vertices is exact (Sterbenz), so
-// a short edge keeps its direction (polygon_projected.h, ltc.h). Of a flattened light (PolygonView::lift), the
-// flattened one's: vertex V_j - x - lift_j n and edge e_j - (n . e_j) n, from the exact e_j = V_{j+1} - V_j (the
-// lifts differ by n . e_j). Returns the number of planes, g.light.count.
+// a short edge keeps its direction (polygon_projected.h, ltc.h). Each edge is taken in the light's plane, scaled
+// by a power of two (edge_in_plane): e_j - (n . e_j) n. Of a flattened light (PolygonView::lift) that is the
+// flattened edge, and the vertex is V_j - x - lift_j n (the lifts differ by n . e_j). Of a light planar up to
+// rounding, an edge a few denorm_min long along the normal (a vertex off the plane by its rounding) made the plane
+// through x and that edge cut the light in two, and the subnormal grid turned a plane of an edge denorm_min long
+// by 0.08 rad: pdf() 0 at the sampler's directions 0.01 rad inside (fuzz_polygon_projected_double a5885e87...;
+// issue 7). An edge that is a point in the plane up to its ends' rounding (edge_in_plane false, as check_polygon
+// drops it from its turns) has no direction and bounds nothing: it takes the plane of the edge before it, so the
+// planes are those of the edges check_polygon found convex. Returns the number of planes, g.light.count.
 template <class T> int polygon_inward_planes(const PolygonLightGeometry<T>& g, const PolygonView<T>& pv, Vec3<T>* out) {
   const int n = g.light.count;
   const T orient = pv.plane_distance < T(0) ? T(-1) : T(1);
   const Vec3<T>& nh = pv.plane_normal;
+  auto rounding = [&](int k) { return pv.vertex_rounding * g.light.vertices[k % n].cwiseAbs().maxCoeff(); };
+  std::array<bool, kMaxPolygonVertices> has_direction{};
+  int last = -1;
   for (int j = 0; j < n; ++j) {
-    Vec3<T> e = g.light.vertices[(j + 1) % n] - g.light.vertices[j];
-    if (pv.flattened) e -= nh.dot(e) * nh;
+    const Vec3<T> edge = g.light.vertices[(j + 1) % n] - g.light.vertices[j];
+    Vec3<T> e;
+    T err;
+    has_direction[j] = edge_in_plane<T>(edge, rounding(j) + rounding(j + 1), nh, e, err);
+    if (has_direction[j]) last = j;
     out[j] = orient * kahan_cross(Vec3<T>(g.light.vertices[j] - g.shading.position - pv.lift[j] * nh), e);
+  }
+  for (int j = 0, prev = last; j < n && last >= 0; ++j) {
+    if (has_direction[j]) prev = j;
+    else out[j] = out[prev];
   }
   return n;
 }

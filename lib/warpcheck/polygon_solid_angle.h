@@ -66,10 +66,13 @@ template <class T> PolygonFanView<T> make_polygon_fan_view(const PolygonLightGeo
   if (!clipped) {
     const int m = g.light.count;
     f.count = m;
+    // The flattened light's vertices where the light is non-planar (PolygonView::lift; zero lifts otherwise, and
+    // then the same values as V - x and V - V_0), like the clipped fan's and the planes below.
+    const Vec3<T>& nh = pv.plane_normal;
     for (int k = 0; k < m; ++k) {
       const int src = reverse ? (m - k) % m : k;  // keeps vertex 0 first
-      f.p[k] = g.light.vertices[src] - g.shading.position;
-      f.e[k] = g.light.vertices[src] - g.light.vertices[0];
+      f.p[k] = g.light.vertices[src] - g.shading.position - pv.lift[src] * nh;
+      f.e[k] = g.light.vertices[src] - g.light.vertices[0] - (pv.lift[src] - pv.lift[0]) * nh;
     }
   } else {
     const LocalPolygon<T> c = clip_to_upper_hemisphere(pv.local);
@@ -115,17 +118,13 @@ template <class T> PolygonFanView<T> make_polygon_fan_view(const PolygonLightGeo
     if (f.u[k].isZero()) return f.reason = NoSample::kNonFinite, f;
   }
   if (!clipped) {
-    // p_j x p_{j+1} = p_j x (V_b - V_a): the edge from the light's own vertices, not from p_{j+1} - p_j. For an
-    // edge shorter than the rounding of V - x (3e-15 at coordinates ~30) the difference of the p's has a
-    // direction of rounding noise, and its plane rejected directions 5e-8 rad inside the light (found by
-    // fuzz_polygon_solid_angle_double, issue 7); V_b - V_a of nearby vertices is exact (Sterbenz).
-    const int m = g.light.count;
-    f.planes = f.count;
-    for (int j = 0; j < f.count; ++j) {
-      const int a = reverse ? (m - j) % m : j, b = reverse ? (m - j - 1 + m) % m : (j + 1) % m;
-      f.inward[j] = kahan_cross(f.p[j], Vec3<T>(g.light.vertices[b] - g.light.vertices[a]));
-    }
-    f.inward[f.planes++] = reverse ? Vec3<T>(-pv.plane_normal) : pv.plane_normal;
+    // The light's own edge planes (polygon_inward_planes: from the exact world edges V_{j+1} - V_j, not from p_{j+1}
+    // - p_j, whose direction is rounding noise for an edge shorter than the rounding of V - x: its plane rejected
+    // directions 5e-8 rad inside the light, found by fuzz_polygon_solid_angle_double, issue 7; and in the light's
+    // plane, scaled, without a plane for an edge that is a point up to rounding), then the light's plane.
+    const int m = polygon_inward_planes(g, pv, f.inward.data());
+    f.inward[m] = reverse ? Vec3<T>(-pv.plane_normal) : pv.plane_normal;
+    f.planes = m + 1;
   } else {
     // The clipped polygon is pv.local's, flattened where the light is non-planar: its planes likewise.
     const int m = polygon_inward_planes(g, pv, f.inward.data());

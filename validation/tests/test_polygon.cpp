@@ -771,6 +771,105 @@ TEST(PolygonKernels, APolygonWoundTwiceWithASubnormalEdgeIsNotSimple) {
   EXPECT_NE(message.find("not simple"), std::string::npos) << message;
 }
 
+// A reflex turn hidden behind an edge along the normal is still a reflex turn: the turns at the edge's two ends
+// are 0 (its projection onto the plane is 0), so testing each vertex with its own two edges passed this pentagon as
+// convex, and the biased projected sampler put a sample 0.016 rad outside (fuzz_polygon_projected_double
+// c42d6431..., issue 7). The turn is taken between the edges either side of it.
+TYPED_TEST(PolygonKernels, AReflexTurnBehindAnEdgeAlongTheNormalIsNotConvex) {
+  using T = TypeParam;
+  const T dm = std::numeric_limits<T>::denorm_min();
+  const PolygonLight<T> hidden{Vec3<T>(1, -16, 0), Vec3<T>(-16, 0, 0), Vec3<T>(0, 0, 0), Vec3<T>(0, 0, -dm),
+                               Vec3<T>(4, T(0.5), 0)};
+  std::string message;
+  EXPECT_EQ(check_polygon(hidden, &message), NoSample::kInvalidGeometry);
+  EXPECT_NE(message.find("not convex"), std::string::npos) << message;
+  for (NoSample r : all_reasons(geom<T>(Vec3<T>(0, 0, -70), Vec3<T>(0, 0, -1), hidden)))
+    EXPECT_EQ(r, NoSample::kInvalidGeometry) << to_string(r);
+}
+
+// A notch of edges shorter than sqrt(denorm_min) is a reflex turn all the same: a unit square whose corner at the
+// origin is notched in by t = sqrt(denorm_min) / 4 (2.8e-163 in double, 1e15 times its vertices' rounding) turns
+// right at (t, t). The squares in those edges' lengths underflowed to 0, so they were dropped as shorter than their
+// rounding and the joined turn of their neighbours, a left one, passed as convex. Edges are scaled by a power of
+// two before their lengths and turns are taken; the same square cut by a convex chamfer there is valid.
+TYPED_TEST(PolygonKernels, AReflexNotchOfEdgesShorterThanTheSquareRootOfDenormMinIsNotConvex) {
+  using T = TypeParam;
+  const T t = std::sqrt(std::numeric_limits<T>::denorm_min()) / T(4);
+  ASSERT_EQ(t * t, T(0));
+  const PolygonLight<T> notched{Vec3<T>(1, 0, 0), Vec3<T>(1, 1, 0), Vec3<T>(0, 1, 0), Vec3<T>(0, t, 0),
+                                Vec3<T>(t, t, 0), Vec3<T>(t, 0, 0)};
+  std::string message;
+  EXPECT_EQ(check_polygon(notched, &message), NoSample::kInvalidGeometry);
+  EXPECT_NE(message.find("not convex"), std::string::npos) << message;
+  // Chamfered instead: (0, 2t), (t/2, t/2), (2t, 0) turn left by 0.32, 0.93 and 0.32 rad; the products of the two
+  // short edges underflow to 0 unscaled (a turn of atan2(0, 0) = 0, and a turning sum 0.93 short of 2 pi).
+  const PolygonLight<T> chamfered{Vec3<T>(1, 0, 0), Vec3<T>(1, 1, 0), Vec3<T>(0, 1, 0), Vec3<T>(0, 2 * t, 0),
+                                  Vec3<T>(t / 2, t / 2, 0), Vec3<T>(2 * t, 0, 0)};
+  EXPECT_EQ(check_polygon(chamfered, &message), NoSample::kNone) << message;
+}
+
+// A light planar up to the subnormal grid: the triangle (1, 0, 0), (0, 0, 0), (0, 4, -12) with its corner at the
+// origin split into three vertices denorm_min apart, one of them denorm_min off the plane along z. The plane
+// through x and the edge along z cut the light in two, and the subnormal grid turned the plane of the edge along x
+// by 0.08 rad, so pdf() was 0 at the projected sampler's directions up to 0.01 rad inside (found by
+// fuzz_polygon_projected_double a5885e87..., issue 7). The edges are taken in the light's plane and scaled, and an
+// edge that is a point in the plane up to rounding takes its predecessor's plane (polygon_inward_planes).
+TYPED_TEST(PolygonKernels, PdfIsPositiveInsideALightWhoseCornerIsSplitIntoVerticesDenormMinApart) {
+  using T = TypeParam;
+  const T dm = std::numeric_limits<T>::denorm_min();
+  const PolygonLight<T> split{Vec3<T>(1, -dm, 0), Vec3<T>(dm, 0, 0), Vec3<T>(0, 0, 0), Vec3<T>(0, 0, -dm),
+                              Vec3<T>(0, 4, -12)};
+  const Vec3<L> xl(4.2L, 4.8L, -2.4L), nl(0.719L, -0.321L, 0.616L);
+  const auto g = geom<T>(xl.cast<T>(), nl.cast<T>(), split);
+  ASSERT_EQ(check_polygon(split), NoSample::kNone);
+  // The triangle's cone in long double: margin = smallest normalised dot product with its inward edge planes.
+  const Vec3<L> tri[3] = {Vec3<L>(1, 0, 0) - xl, Vec3<L>(0, 0, 0) - xl, Vec3<L>(0, 4, -12) - xl};
+  const L orient = tri[0].cross(tri[1]).dot(tri[0] + tri[1] + tri[2]) > 0 ? 1 : -1;  // the centroid is inside
+  auto margin = [&](const Vec3<L>& w) {
+    L m = std::numeric_limits<L>::infinity();
+    for (int k = 0; k < 3; ++k) m = std::min(m, orient * tri[k].cross(tri[(k + 1) % 3]).normalized().dot(w));
+    return m;
+  };
+  int inside = 0, zero = 0;
+  for (int i = 0; i < 32; ++i)
+    for (int j = 0; j < 32; ++j) {
+      const Vec2<T> u(T((i + 0.5) / 32), T((j + 0.5) / 32));
+      for (int kernel = 0; kernel < 3; ++kernel) {  // projected, solid angle, solid angle clipped: sample and pdf
+        const DirectionSample<T> s = kernel == 0 ? sample_polygon_projected_solid_angle(g, u)
+                                                 : sample_polygon_solid_angle(g, u, kernel == 2);
+        if (!s.valid() || !(margin(s.direction.template cast<L>().normalized()) > L(1e-4))) continue;
+        ++inside;
+        zero += (kernel == 0 ? pdf_polygon_projected_solid_angle(g, s.direction)
+                             : pdf_polygon_solid_angle(g, s.direction, kernel == 2)) == T(0);
+      }
+    }
+  EXPECT_GT(inside, 1000);
+  EXPECT_EQ(zero, 0) << "of " << inside << " samples 1e-4 rad or more inside the light";
+}
+
+// The pentagon (-1, 0) (0, -1) (0.5, 0) (0, 2) (0, 0) in the plane x = 0 turns right by 90 degrees at the origin,
+// where three more vertices lie within 1e-307 of it: an edge along x (x = 4.4e-308) and two edges whose squared
+// lengths underflow. Each vertex's own turns were 0 there, and the clipped solid-angle kernel sampled the light
+// 0.26 rad outside itself (fuzz_polygon_solid_angle_double 641e4492..., issue 7).
+TEST(PolygonKernels, AReflexCornerBehindSubnormalEdgesIsNotConvex) {
+  const PolygonLight<double> hidden{
+      Vec3<double>(0, 0, 0),
+      Vec3<double>(0, -4.4501477170144028e-308, -6.6752215755216041e-308),
+      Vec3<double>(3.1287384980645084e-308, 8.900023818567562e-308, 8.900023818567562e-308),
+      Vec3<double>(8.900023818567562e-308, -1, -4.4501477170144028e-308),
+      Vec3<double>(-6.6752215755216041e-308, 0, -1),
+      Vec3<double>(-8.6297664346302249e-308, 0.5, 0),
+      Vec3<double>(4.6812924745326679e-308, -4.4501477170144028e-308, 2),
+      Vec3<double>(4.3806141589360527e-308, 0, 0)};
+  std::string message;
+  EXPECT_EQ(check_polygon(hidden, &message), NoSample::kInvalidGeometry);
+  EXPECT_NE(message.find("not convex"), std::string::npos) << message;
+  for (NoSample r : all_reasons(geom<double>(Vec3<double>(3.9998779296875, 3.9998779296875, -2),
+                                             Vec3<double>(-0.65742177715904948, -0.66768475450745457, 0.34926496455762607),
+                                             hidden)))
+    EXPECT_EQ(r, NoSample::kInvalidGeometry) << to_string(r);
+}
+
 // check_polygon accepts vertices off the light's plane up to its planarity tolerance (about 8 sqrt(eps) of the
 // width). A shading point closer to the plane than that, with vertices on both sides of it, does not see a
 // convex spherical polygon, and which side of the light it is on is undetermined: edge-on (fuzz_polygon_projected_double
