@@ -222,8 +222,19 @@ template <class T> void check_ltc(FuzzedDataProvider& in, const Mutation& mutate
                                describe(g, Vec2<T>(Vec2<T>::Zero()), "ltc view")
                                    << "vertex " << i << " angle " << angle << " allowed " << allowed << "\n");
     }
-    const L a_ref = reference_projected_solid_angle(kt_l);
-    const L kappa_k = polygon_kappa<L, T>(kt_l, true);
+    // (2) on the polygon the sectors sum over: M^-1 P as make_polygon_view accepts it, flattened onto its plane where
+    // the rounding of its vertices (cond(M) eps, ltc_vertex_rounding) leaves it non-planar beyond the offsets' own
+    // rounding (polygon.h). On the unflattened polygon Lambert's formula gave 1.3e-11 more, allowed 6.6e-13
+    // (fuzz_ltc_double 511c2f54: cond(M) ~1e6, M^-1 P non-planar by 7e-10 at size 4 and seen from 5.3e-5 off its
+    // plane; the kernel's A_Sigma, in double and in long double, equals Lambert's formula of the flattened polygon
+    // to 20 digits; issue 7). Flattening moves each vertex by at most the non-planarity, which step (1) bounds.
+    const PolygonView<T> kpv = make_polygon_view(kt, ltc_vertex_rounding(view.m, view.m_inv));
+    PolygonLightGeometry<L> flat_l = kt_l;
+    if (kpv.valid() && kpv.flattened)
+      for (int i = 0; i < kpv.local.count; ++i)
+        flat_l.light.vertices[i] = kpv.frame.to_world(kpv.local.v[i]).template cast<L>();
+    const L a_ref = reference_projected_solid_angle(flat_l);
+    const L kappa_k = polygon_kappa<L, T>(flat_l, true);
     const L rel = a_ref > 0 ? kTwoPi<L> * e * (1 + kappa_k) / a_ref + 16 * eps<T>() : L(1);
     const L a = L(mutate.normaliser(view.transformed.projected_solid_angle));
     if (rel < L(0.5))

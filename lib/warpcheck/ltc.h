@@ -88,6 +88,16 @@ template <class T> PolygonLightGeometry<T> ltc_transformed_polygon(const Polygon
   return tg;
 }
 
+// The rounding of M^-1 P's computed vertices relative to |M^-1 v|_inf, the vertex_rounding of check_polygon and
+// make_polygon_view for the transformed polygon. M^-1 P is convex, but its vertices carry the rounding of the frame
+// change (a few eps |v|) and of the product: 3 eps |M^-1|_F |v|_2 <= 3 eps cond_F(M) |M^-1 v|_2 <= 3 sqrt(3) eps
+// cond_F(M) |M^-1 v|_inf. check_polygon forgives reflex turns up to that rounding (and no further: polygon.h), and
+// make_polygon_view flattens the polygon where that rounding leaves it non-planar.
+template <class T> T ltc_vertex_rounding(const Mat3<T>& m, const Mat3<T>& m_inv) {
+  const T eps = std::numeric_limits<T>::epsilon();
+  return kPolygonVertexRounding<T> + T(3) * std::sqrt(T(3)) * eps * (m.norm() * m_inv.norm());
+}
+
 template <class T> LtcPolygonView<T> make_ltc_polygon_view(const LtcPolygonGeometry<T>& g) {
   LtcPolygonView<T> v;
   const PolygonView<T> pv = make_polygon_view(g.polygon);
@@ -99,13 +109,8 @@ template <class T> LtcPolygonView<T> make_ltc_polygon_view(const LtcPolygonGeome
   // |M| > 0 (Sec. 4.1). A singular or reflecting M has no LTC; an M whose inverse overflows neither.
   if (!ltc_inverse(g.m, &v.m_inv, &v.det)) return v.reason = NoSample::kInvalidGeometry, v;
   v.det_inv = T(1) / v.det;
-  // M^-1 P is convex, but its computed vertices carry the rounding of the frame change (a few eps |v|) and of
-  // the product: 3 eps |M^-1|_F |v|_2 <= 3 eps cond_F(M) |M^-1 v|_2 <= 3 sqrt(3) eps cond_F(M) |M^-1 v|_inf.
-  // check_polygon forgives reflex turns up to that rounding (and no further: polygon.h).
-  const T eps = std::numeric_limits<T>::epsilon();
-  const T cond = g.m.norm() * v.m_inv.norm();
-  const T rounding = kPolygonVertexRounding<T> + T(3) * std::sqrt(T(3)) * eps * cond;
-  v.transformed = make_polygon_projected_view(ltc_transformed_polygon(pv, v.m_inv), rounding);
+  v.transformed =
+      make_polygon_projected_view(ltc_transformed_polygon(pv, v.m_inv), ltc_vertex_rounding(g.m, v.m_inv));
   if (!v.transformed.valid()) return v.reason = v.transformed.reason, v;
   v.integral = v.transformed.projected_solid_angle / kPi<T>;
   return v;
