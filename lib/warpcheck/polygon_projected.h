@@ -33,6 +33,8 @@
 // Kahan cross products, the same computation as n_{j,z}, so sorting and edge classification agree (Sec. 3.7).
 #pragma once
 
+#include <type_traits>
+
 #include "warpcheck/polygon.h"
 
 namespace warpcheck {
@@ -181,11 +183,32 @@ template <class T> Vec2<T> l1_normalized(const Vec2<T>& w) {
   return s > T(0) && std::isfinite(s) ? Vec2<T>(w / s) : w;
 }
 
+// The scalar in which a float kernel takes the difference of Eq. 1's two ellipse areas: double (float inputs are
+// exact in it). Why (our remedy, issue 5): near a sector's tip, where the inner and outer ellipses meet, the area
+// between them shrinks faster than either term. At a tip on the horizon the inner ellipse touches the unit
+// circle, the area grows with the cube of the angle from the tip, and the terms were up to ~4000 times larger than
+// their difference: the float LTC sampler of a light straddling the horizon (polygon-ltc lobe-away) put samples
+// near both tips where the float warp's density was off its pdf by 2.9e-4 at xi_0 in [3e-4, 6e-4] and by 8.8e-5
+// at xi_0 = 0.99966 (its battery's pdf-consistency failure), against the long double warp. In double the same
+// cancellation costs 4000 eps_d, far below float's own rounding. A cancellation-free formula for the area
+// between two ellipses near their common point is not known to us. The biased variant (Sec. 6.4) stays in T: its
+// approximate atan2 (1.2e-5 rad) dominates the cancellation, and it exists to be cheap.
+template <class T, bool kBiased> using EllipseAreaScalar =
+    std::conditional_t<std::is_same_v<T, float> && !kBiased, double, T>;
+
+template <class A, class T> EdgeEllipse<A> ellipse_cast(const EdgeEllipse<T>& e) {
+  return EdgeEllipse<A>{e.nxy.template cast<A>(), A(e.nz)};
+}
+
 // Eq. 1 applied to both ellipses of a decentral sector: the area between them from a counterclockwise to b,
-// given cross = a x b.
+// given cross = a x b (in the wider scalar recomputed from a and b, exactly; a clamped 0 stays 0).
 template <class T, bool kBiased = false>
 T area_between_ellipses(const ProjectedSector<T>& s, const Vec2<T>& a, const Vec2<T>& b, T cross) {
-  return ellipse_sector_area<T, kBiased>(s.outer, a, b, cross) - ellipse_sector_area<T, kBiased>(s.inner, a, b, cross);
+  using A = EllipseAreaScalar<T, kBiased>;
+  const Vec2<A> aa = a.template cast<A>(), ba = b.template cast<A>();
+  const A c = std::is_same_v<A, T> || cross == T(0) ? A(cross) : kahan_cross2(aa, ba);
+  return T(ellipse_sector_area<A, kBiased>(ellipse_cast<A>(s.outer), aa, ba, c) -
+           ellipse_sector_area<A, kBiased>(ellipse_cast<A>(s.inner), aa, ba, c));
 }
 
 // The area between the ellipses in the sector from s0 to w (the subtracted terms of Eq. 7).
@@ -205,9 +228,15 @@ template <class T, bool kBiased = false> T decentral_area_from(const ProjectedSe
 // tip is tiny and the difference from s0 cannot resolve it: float samples of the 1 cm light 40 m away with A
 // within 5e-4 of A_j were up to 1.7e-2 light widths off and piled up in the corner (chi2 bin +18 sigma at 1e7).
 // From s1, both terms shrink with the area they bound.
+// `rest` is A_j - A, the area the sample leaves to s1, which the caller may know more accurately than the
+// difference (sample_polygon_projected_solid_angle takes it from (1 - xi_0) A_Sigma for xi_0 > 1/2).
+template <class T, bool kBiased = false>
+T decentral_residual(const ProjectedSector<T>& s, T target, T rest, const Vec2<T>& w) {
+  if (target <= rest) return target - decentral_area_to<T, kBiased>(s, w);
+  return decentral_area_from<T, kBiased>(s, w) - rest;
+}
 template <class T, bool kBiased = false> T decentral_residual(const ProjectedSector<T>& s, T target, const Vec2<T>& w) {
-  if (target <= s.area / T(2)) return target - decentral_area_to<T, kBiased>(s, w);
-  return decentral_area_from<T, kBiased>(s, w) - (s.area - target);
+  return decentral_residual<T, kBiased>(s, target, s.area - target, w);
 }
 
 // Section 3.4: the two-quad initialisation. The quad vertices are lambda_{l,j} s_j (l in {i, o}, j in {k, h});
@@ -265,8 +294,8 @@ Vec2<T> decentral_initialization(const ProjectedSector<T>& s, T target) {
 
 // Section 3.3: one step of the tangent-line iteration (Eq. 5 in homogeneous form, Eq. 6, Eq. 7).
 template <class T, bool kBiased = false>
-Vec2<T> decentral_iteration(const ProjectedSector<T>& s, T target, const Vec2<T>& wn) {
-  const T a_delta = decentral_residual<T, kBiased>(s, target, wn);
+Vec2<T> decentral_iteration(const ProjectedSector<T>& s, T target, T rest, const Vec2<T>& wn) {
+  const T a_delta = decentral_residual<T, kBiased>(s, target, rest, wn);
   // T = R w_n x^T - 2 A_delta (C_i w_n)(C_o w_n)^T with x = c_o C_i w_n - c_i C_o w_n (homogeneous C = Ct / n_z^2,
   // c = n_z^2). With w = w_n + tau R w_n (increasing_root_around) and f = w_n^T Ct w_n, g = (R w_n)^T Ct w_n
   // = (n_xy . w_n)(n_xy . R w_n) (the n_z^2 w_n . R w_n term is 0), P(tau) = tau |w_n|^2 (x . w_n + tau x . R w_n)
@@ -302,12 +331,17 @@ template <class T> Vec2<T> clamp_to_sector(const ProjectedSector<T>& s, const Ve
   return w;
 }
 
-// The decentral inversion: initialisation plus `iterations` steps, each kept inside the sector.
+// The decentral inversion: initialisation plus `iterations` steps, each kept inside the sector. `target` is the
+// area from s0, `rest` the area to s1 (decentral_residual).
+template <class T, bool kBiased = false>
+Vec2<T> invert_decentral_sector(const ProjectedSector<T>& s, T target, T rest, int iterations) {
+  Vec2<T> w = clamp_to_sector(s, decentral_initialization<T, kBiased>(s, target));
+  for (int k = 0; k < iterations; ++k) w = clamp_to_sector(s, decentral_iteration<T, kBiased>(s, target, rest, w));
+  return w;
+}
 template <class T, bool kBiased = false>
 Vec2<T> invert_decentral_sector(const ProjectedSector<T>& s, T target, int iterations) {
-  Vec2<T> w = clamp_to_sector(s, decentral_initialization<T, kBiased>(s, target));
-  for (int k = 0; k < iterations; ++k) w = clamp_to_sector(s, decentral_iteration<T, kBiased>(s, target, w));
-  return w;
+  return invert_decentral_sector<T, kBiased>(s, target, s.area - target, iterations);
 }
 
 // Section 3.2: the central case in closed form. The angle in the Cholesky-transformed circle is
@@ -533,18 +567,27 @@ template <class T, bool kBiased = false>
 DirectionSample<T> sample_polygon_projected_solid_angle(const PolygonProjectedView<T>& v, const Vec2<T>& u,
                                                         int iterations = 2) {
   if (!v.valid()) return DirectionSample<T>::none(v.reason);
-  // Sector selection by xi_0 (Sec. 3.2): A = xi_0 A_Sigma - sum_{k<j} A_k in [0, A_j).
-  T target = u[0] * v.projected_solid_angle;
+  // Sector selection by xi_0 (Sec. 3.2): A = xi_0 A_Sigma - sum_{k<j} A_k in [0, A_j). For xi_0 > 1/2 we count
+  // from the other end instead: rest = A_j - A = (1 - xi_0) A_Sigma - sum_{k>j} A_k (1 - xi_0 is exact there).
+  // Why (our remedy, issue 5): the subtraction from xi_0 A_Sigma leaves an absolute error of eps A_Sigma, and
+  // near the last sector's tip, where the area to s1 grows with the cube of the angle (a tip on the horizon),
+  // that moved float samples of polygon-ltc lobe-away far enough that the density at them was off the warp's by
+  // 1.4e-4 at xi_0 = 1 - 3e-4 (measured against the long double warp); counted from the end, the area left to
+  // the tip carries its own relative rounding only, as the first sector's area from its tip always did.
+  const bool from_end = u[0] > T(0.5);
+  T left = from_end ? (T(1) - u[0]) * v.projected_solid_angle : u[0] * v.projected_solid_angle;
   int k = -1;
-  for (int i = 0; i < v.sector_count; ++i) {
+  for (int n = 0; n < v.sector_count; ++n) {
+    const int i = from_end ? v.sector_count - 1 - n : n;
     if (!(v.sectors[i].area > T(0))) continue;
     k = i;
-    if (target < v.sectors[i].area) break;
-    target -= v.sectors[i].area;
+    if (left < v.sectors[i].area) break;
+    left -= v.sectors[i].area;
   }
   if (k < 0) return DirectionSample<T>::none(NoSample::kTooSmall);
   const ProjectedSector<T>& s = v.sectors[k];
-  target = std::clamp(target, T(0), s.area);
+  left = std::clamp(left, T(0), s.area);
+  const T target = from_end ? s.area - left : left, rest = from_end ? left : s.area - left;
   // Sec. 3.2 / 3.3: the squared radius is interpolated linearly in xi_1 between the inner boundary (the
   // origin in the central case) and the outer one, r^2 = (1 - xi_1) r_i^2 + xi_1 r_o^2 (with r^2 = 1 / (w^T C w)
   // for unit w, Eq. 3); z^2 = 1 - r^2 is interpolated in the same way, from each boundary's own z^2 (no
@@ -557,7 +600,7 @@ DirectionSample<T> sample_polygon_projected_solid_angle(const PolygonProjectedVi
     // u_0 = 1 - ulp, sample 5.8e-6 rad outside, issue 7).
     w = clamp_to_sector(s, invert_central_sector(s, target));
   } else {
-    w = invert_decentral_sector<T, kBiased>(s, target, iterations);
+    w = invert_decentral_sector<T, kBiased>(s, target, rest, iterations);
     edge_boundary_point(s.inner, s.inner_a, s.inner_b, w, &ri2, &zi2);
   }
   edge_boundary_point(s.outer, s.outer_a, s.outer_b, w, &ro2, &zo2);
