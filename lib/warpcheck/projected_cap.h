@@ -170,18 +170,26 @@ template <class T> T quintic_density(T s, T e) {
 // inverse factor of quintic_inverse_density)).
 // right_area = pi - left_area, computed by the caller without cancellation (pi - a loses the digits of a small
 // right-area: absolute error eps pi, 1.7e-4 relative for float at u0 = 1 - 3.6e-5 in Case 1).
-template <class T, CutDiskInverse M> CutDiskX<T> sample_cut_unit_disk_x(T left_area, T right_area) {
-  const T a = std::clamp(left_area, T(0), kPi<T>);
+// Always inlined: GCC 12 kept it out of line (20% of the float sample's time on main under perf, q_z = -0.1),
+// returning CutDiskX through the stack; inlined, the float q_z = -0.1 sample took 44.3 ns instead of 50.8 with the
+// other float changes of issue 9 (warpcheck_bench, one run each).
+template <class T, CutDiskInverse M>
+[[gnu::always_inline]] inline CutDiskX<T> sample_cut_unit_disk_x(T left_area, T right_area) {
+  // std::min(std::max(v, lo), hi) is std::clamp(v, lo, hi) for lo <= hi (same comparisons, same operand returned;
+  // NaN and -0 included), written so that it compiles to minss/maxss instead of branches on random data.
+  const T a = std::min(std::max(left_area, T(0)), kPi<T>);
   const bool positive = a >= kPi<T> / T(2);
-  // pi/2 - |A| of Alg. 5: the area between the point and the nearer end of the disk.
-  const T e = positive ? std::clamp(right_area, T(0), kPi<T> / T(2)) : a;
+  // pi/2 - |A| of Alg. 5: the area between the point and the nearer end of the disk: the right-area (clamped to
+  // pi/2) where a >= pi/2, else a; the smaller of the two in either case, taken without a branch (u0 is random,
+  // so a branch on `positive` is mispredicted for half of the samples).
+  const T e = std::min(a, std::min(std::max(right_area, T(0)), kPi<T> / T(2)));
   CutDiskX<T> out;
   if constexpr (M == CutDiskInverse::kQuintic) {
     const T er = kQuinticKappa<T> * e;  // the rescaled argument: er <= e0, so q <= 1 and no fold
     const T s = kPi<T> / T(2) - er;
     const T q = std::min(T(1), quintic_g(s) * cube_root(er * er));
     const T m = T(1) - q;  // |d_x|
-    out.x = positive ? m : -m;
+    out.x = std::copysign(m, a - kPi<T> / T(2));  // -m where a < pi/2 (m >= 0), without a branch
     out.half_height = std::sqrt(q * (T(2) - q));  // sqrt(1 - m^2) = sqrt((1 - m)(1 + m))
     out.inv_density = kQuinticKappa<T> * quintic_inverse_density(s, er, q);  // d er / d a = kappa
   } else {
@@ -229,6 +237,18 @@ template <class T, CutDiskInverse M> CutDiskPreimage<T> cut_disk_preimage(T x, T
 
 // ---- ComputeGeometry (Alg. 1) and the per-light precomputation (Sec. 3.7) ----------------------------------
 
+namespace projected_cap_detail {
+// The pieces of a view, with their u0 ranges and left-area maps a = alpha + beta u0. With the exact inverse these
+// are Alg. 2-4's: ellipse a = u0 (A_E + A_D) / A_E * A_E' = u0 A_E' / tau, disk a = (1 - u0) A_D / (1 - tau)
+// (= total (1 - u0)), lune a = (1 - u0) A_D. With the quintic the same maps end at the left-areas where the
+// quintic reaches the cuts (quintic_area_*), so that the pieces meet exactly; tau is the same.
+template <class T> struct Piece {
+  int kind;
+  T u_lo, u_hi, alpha, beta;
+  T right_hi = T(0);  // pieces with alpha = 0: the right-area pi - a at u_hi, without cancellation
+};
+}  // namespace projected_cap_detail
+
 template <class T> struct ProjectedCapView {
   NoSample reason = NoSample::kNone;
   int which_case = 4;   // 1: entirely above, 2: mostly above, 3: mostly below (Sec. 3.2)
@@ -251,6 +271,10 @@ template <class T> struct ProjectedCapView {
   T sy_m = T(0), sy_one_minus_m = T(0), one_minus_k2 = T(0);
   // 1 - c_x = 1 - w_dx v = (h^2 + w_dx^2 r_y^2) / (1 + w_dx v), for the inverse of the ellipse piece.
   T one_minus_cx = T(0);
+  // The quintic sampler's pieces (projected_cap_detail::pieces<T, kQuintic>), formed once per light (Sec. 3.7's
+  // split) instead of per sample: Case 2's maps divide by tau and 1 - tau.
+  std::array<projected_cap_detail::Piece<T>, 2> quintic_pieces{};
+  int quintic_piece_count = 0;
 
   bool valid() const { return reason == NoSample::kNone; }
   Vec3<T> to_world(const Vec3<T>& w) const { return w.x() * x + w.y() * y + w.z() * z; }
@@ -290,6 +314,10 @@ template <class T> int unit_scale_geometry(const SphereLightGeometry<T>& g, Sphe
   return e;
 }
 
+}  // namespace projected_cap_detail
+
+namespace projected_cap_detail {
+template <class T, CutDiskInverse M> int pieces(const ProjectedCapView<T>& p, std::array<Piece<T>, 2>& out);
 }  // namespace projected_cap_detail
 
 template <class T> ProjectedCapView<T> make_projected_cap_view(const SphereLightGeometry<T>& g) {
@@ -395,6 +423,7 @@ template <class T> ProjectedCapView<T> make_projected_cap_view(const SphereLight
     }
   }
   if (!(p.total > T(0)) || !std::isfinite(p.total)) return p.reason = NoSample::kTooSmall, p;
+  p.quintic_piece_count = projected_cap_detail::pieces<T, CutDiskInverse::kQuintic>(p, p.quintic_pieces);
   return p;
 }
 
@@ -508,15 +537,7 @@ template <class T> bool local_to_disk(const ProjectedCapView<T>& p, int piece, c
   return std::abs(dy) <= hh && std::isfinite(area_factor) && area_factor > T(0);
 }
 
-// The pieces of a view, with their u0 ranges and left-area maps a = alpha + beta u0. With the exact inverse these
-// are Alg. 2-4's: ellipse a = u0 (A_E + A_D) / A_E * A_E' = u0 A_E' / tau, disk a = (1 - u0) A_D / (1 - tau)
-// (= total (1 - u0)), lune a = (1 - u0) A_D. With the quintic the same maps end at the left-areas where the
-// quintic reaches the cuts (quintic_area_*), so that the pieces meet exactly; tau is the same.
-template <class T> struct Piece {
-  int kind;
-  T u_lo, u_hi, alpha, beta;
-  T right_hi = T(0);  // pieces with alpha = 0: the right-area pi - a at u_hi, without cancellation
-};
+// The pieces of a view: see Piece (declared before ProjectedCapView, which stores the quintic's pieces).
 // Every piece's map is a = beta u0 (alpha = 0) or a = alpha (1 - u0) (alpha = -beta); the second is evaluated in
 // that form: 1 - u0 is exact for u0 >= 1/2, where a is small, and alpha + beta u0 cancels there (relative error
 // eps / (1 - u0) in a: 1.7e-3 in float at u0 = 1 - 3.6e-5, which moved float samples near the disk's edge and
@@ -600,9 +621,11 @@ DirectionSample<T> sample_projected_spherical_cap(const ProjectedCapView<T>& p, 
   using namespace projected_cap_detail;
   if (!p.valid()) return DirectionSample<T>::none(p.reason);
   if (!std::isfinite(u[0]) || !std::isfinite(u[1])) return DirectionSample<T>::none(NoSample::kNonFinite);
-  const T u0 = std::clamp(u[0], T(0), T(1)), u1 = std::clamp(u[1], T(0), T(1));
-  std::array<Piece<T>, 2> ps{};
-  const int n = pieces<T, M>(p, ps);
+  const T u0 = std::min(std::max(u[0], T(0)), T(1)), u1 = std::min(std::max(u[1], T(0)), T(1));  // clamps
+  std::array<Piece<T>, 2> exact_pieces{};
+  const std::array<Piece<T>, 2>& ps = M == CutDiskInverse::kQuintic ? p.quintic_pieces : exact_pieces;
+  int n = p.quintic_piece_count;
+  if constexpr (M == CutDiskInverse::kExact) n = pieces<T, M>(p, exact_pieces);
   int i = 0;
   while (i + 1 < n && u0 >= ps[i].u_hi) ++i;  // Alg. 2's threshold xi_0 < A_E / (A_E + A_D)
   const Piece<T>& pc = ps[i];
