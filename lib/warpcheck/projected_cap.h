@@ -88,6 +88,8 @@ template <class T> struct CutDiskX {
   T half_height = T(1);
   T inv_density = T(1);  // 1 / density of x per unit disk area when the left-area is uniform (1 for the exact
                          // inverse); kept inverted so that a sample's pdf costs one division
+  T one_minus_abs_x = T(-1);  // 1 - |x| where known without cancellation (quintic: q); -1 (unknown) otherwise
+  T half_height2 = T(-1);     // half_height^2 (before its square root; quintic), else -1
   T density() const { return T(1) / inv_density; }
 };
 
@@ -170,20 +172,36 @@ template <class T> T quintic_density(T s, T e) {
 // inverse factor of quintic_inverse_density)).
 // right_area = pi - left_area, computed by the caller without cancellation (pi - a loses the digits of a small
 // right-area: absolute error eps pi, 1.7e-4 relative for float at u0 = 1 - 3.6e-5 in Case 1).
-template <class T, CutDiskInverse M> CutDiskX<T> sample_cut_unit_disk_x(T left_area, T right_area) {
-  const T a = std::clamp(left_area, T(0), kPi<T>);
+// Always inlined: GCC 12 kept it out of line (20% of the float sample's time on main under perf, q_z = -0.1),
+// returning CutDiskX through the stack; inlined, the float q_z = -0.1 sample took 44.3 ns instead of 50.8 with the
+// other float changes of issue 9 (warpcheck_bench, one run each).
+template <class T, CutDiskInverse M>
+[[gnu::always_inline]] inline CutDiskX<T> sample_cut_unit_disk_x(T left_area, T right_area) {
+  // std::min(std::max(v, lo), hi) is std::clamp(v, lo, hi) for lo <= hi (same comparisons, same operand returned;
+  // NaN and -0 included), written so that it compiles to minss/maxss instead of branches on random data.
+  const T a = std::min(std::max(left_area, T(0)), kPi<T>);
   const bool positive = a >= kPi<T> / T(2);
-  // pi/2 - |A| of Alg. 5: the area between the point and the nearer end of the disk.
-  const T e = positive ? std::clamp(right_area, T(0), kPi<T> / T(2)) : a;
+  // pi/2 - |A| of Alg. 5: the area between the point and the nearer end of the disk: the right-area (clamped to
+  // pi/2) where a >= pi/2, else a; the smaller of the two in either case, taken without a branch (u0 is random,
+  // so a branch on `positive` is mispredicted for half of the samples).
+  const T e = std::min(a, std::min(std::max(right_area, T(0)), kPi<T> / T(2)));
   CutDiskX<T> out;
   if constexpr (M == CutDiskInverse::kQuintic) {
     const T er = kQuinticKappa<T> * e;  // the rescaled argument: er <= e0, so q <= 1 and no fold
     const T s = kPi<T> / T(2) - er;
-    const T q = std::min(T(1), quintic_g(s) * cube_root(er * er));
+    // er^(2/3): for float by the division-free root of core.h (issue 9: the Halley steps' divisions of cube_root were
+    // on the sample's critical path), else cube_root(er^2).
+    T er23;
+    if constexpr (std::is_same_v<T, float>) er23 = cube_root_squared_for_float(er);
+    else er23 = cube_root(er * er);
+    const T q = std::min(T(1), quintic_g(s) * er23);
     const T m = T(1) - q;  // |d_x|
-    out.x = positive ? m : -m;
-    out.half_height = std::sqrt(q * (T(2) - q));  // sqrt(1 - m^2) = sqrt((1 - m)(1 + m))
+    out.x = std::copysign(m, a - kPi<T> / T(2));  // -m where a < pi/2 (m >= 0), without a branch
+    const T hh2 = q * (T(2) - q);  // 1 - m^2 = (1 - m)(1 + m)
+    out.half_height = std::sqrt(hh2);
     out.inv_density = kQuinticKappa<T> * quintic_inverse_density(s, er, q);  // d er / d a = kappa
+    out.one_minus_abs_x = q;
+    out.half_height2 = hh2;
   } else {
     const T theta = solve_cut_disk_angle(e);  // C(theta) = e: the area beyond |x| = cos(theta)
     out.x = positive ? std::cos(theta) : -std::cos(theta);
@@ -229,6 +247,18 @@ template <class T, CutDiskInverse M> CutDiskPreimage<T> cut_disk_preimage(T x, T
 
 // ---- ComputeGeometry (Alg. 1) and the per-light precomputation (Sec. 3.7) ----------------------------------
 
+namespace projected_cap_detail {
+// The pieces of a view, with their u0 ranges and left-area maps a = alpha + beta u0. With the exact inverse these
+// are Alg. 2-4's: ellipse a = u0 (A_E + A_D) / A_E * A_E' = u0 A_E' / tau, disk a = (1 - u0) A_D / (1 - tau)
+// (= total (1 - u0)), lune a = (1 - u0) A_D. With the quintic the same maps end at the left-areas where the
+// quintic reaches the cuts (quintic_area_*), so that the pieces meet exactly; tau is the same.
+template <class T> struct Piece {
+  int kind;
+  T u_lo, u_hi, alpha, beta;
+  T right_hi = T(0);  // pieces with alpha = 0: the right-area pi - a at u_hi, without cancellation
+};
+}  // namespace projected_cap_detail
+
 template <class T> struct ProjectedCapView {
   NoSample reason = NoSample::kNone;
   int which_case = 4;   // 1: entirely above, 2: mostly above, 3: mostly below (Sec. 3.2)
@@ -251,6 +281,13 @@ template <class T> struct ProjectedCapView {
   T sy_m = T(0), sy_one_minus_m = T(0), one_minus_k2 = T(0);
   // 1 - c_x = 1 - w_dx v = (h^2 + w_dx^2 r_y^2) / (1 + w_dx v), for the inverse of the ellipse piece.
   T one_minus_cx = T(0);
+  // float: the quintic sampler's pieces (projected_cap_detail::pieces<T, kQuintic>), formed once per light (Sec.
+  // 3.7's split) instead of per sample (Case 2's maps divide by tau and 1 - tau): float q_z = 0.1 at 500 samples per
+  // light 40.4 -> 35.2 ns. Not for double and long double: there it cost 20-35 ns per light at 1 sample per light
+  // (double, warpcheck_bench, q_z = 2: 204 -> 224 ns, -0.1: 346 -> 379 ns; cause not found), so they form them per
+  // sample as before.
+  std::array<projected_cap_detail::Piece<T>, 2> quintic_pieces{};
+  int quintic_piece_count = 0;
 
   bool valid() const { return reason == NoSample::kNone; }
   Vec3<T> to_world(const Vec3<T>& w) const { return w.x() * x + w.y() * y + w.z() * z; }
@@ -290,6 +327,10 @@ template <class T> int unit_scale_geometry(const SphereLightGeometry<T>& g, Sphe
   return e;
 }
 
+}  // namespace projected_cap_detail
+
+namespace projected_cap_detail {
+template <class T, CutDiskInverse M> int pieces(const ProjectedCapView<T>& p, std::array<Piece<T>, 2>& out);
 }  // namespace projected_cap_detail
 
 template <class T> ProjectedCapView<T> make_projected_cap_view(const SphereLightGeometry<T>& g) {
@@ -395,6 +436,8 @@ template <class T> ProjectedCapView<T> make_projected_cap_view(const SphereLight
     }
   }
   if (!(p.total > T(0)) || !std::isfinite(p.total)) return p.reason = NoSample::kTooSmall, p;
+  if constexpr (std::is_same_v<T, float>)
+    p.quintic_piece_count = projected_cap_detail::pieces<T, CutDiskInverse::kQuintic>(p, p.quintic_pieces);
   return p;
 }
 
@@ -412,6 +455,10 @@ template <class T> struct Case3Sy {
 template <class T> Case3Sy<T> case3_sy(const ProjectedCapView<T>& p, T d_z) {
   const T den = p.t_y + d_z;
   if (!(den > T(0))) return {T(0), T(0)};
+  if constexpr (std::is_same_v<T, float>) {
+    // float (issue 9): two divisions side by side instead of a reciprocal and products after it (shorter chain)
+    return {std::sqrt((p.t_y + p.sy_m * d_z) / den), p.sy_one_minus_m * d_z / den};
+  }
   const T inv = T(1) / den;
   const T r = d_z * inv;  // in [0, 1]
   return {std::sqrt(p.t_y * inv + p.sy_m * r), p.sy_one_minus_m * r};
@@ -423,6 +470,12 @@ template <class T> Case3Sy<T> case3_sy(const ProjectedCapView<T>& p, T d_z) {
 template <class T> struct Local {
   Vec3<T> w;
   T pdf_proj;
+  // pdf_proj = pdf_num / pdf_den before its rounding (pdf_den > 0 wherever pdf_proj > 0), for the float sampler's
+  // one division w_z pdf_num / pdf_den.
+  T pdf_num = T(1), pdf_den = T(0);
+  // |w|^2 with the radicand of w's last square root in place of that component's square: known one square root
+  // earlier than w (the float sampler renormalises with it); equal to |w|^2 up to the root's rounding.
+  T norm2 = T(1);
 };
 
 // The cut-disk point is (d_x, d_y) with d_y = (2 u1 - 1) hh and hh = sqrt(1 - d_x^2) as Alg. 5 returns it.
@@ -434,34 +487,65 @@ template <class T> struct Local {
 //      1 - w_x^2 - w_y^2 = (c_z - r_z d_x)^2 + r_y^2 (1 - d_x^2 - d_y^2),
 //    a sum of squares, where c_z - r_z d_x = (c_z - r_z) + r_z hh^2 / (1 + d_x) for d_x > 0 (c_z - r_z from the
 //    view, without cancellation) and c_z + r_z |d_x| otherwise. The identity is ours (not in the paper).
+// one_minus_abs_dx: 1 - |d_x| if the caller has it without cancellation, else negative (then hh^2 / (1 + d_x) is
+// used for d_x > 0); hh2: hh^2 if the caller has it before hh (then the ellipse's height does not wait for hh),
+// else negative.
 template <class T>
-Local<T> disk_to_local(const ProjectedCapView<T>& p, int piece, T dx, T hh, T u1, T inv_disk_density) {
+Local<T> disk_to_local(const ProjectedCapView<T>& p, int piece, T dx, T hh, T u1, T inv_disk_density,
+                       T one_minus_abs_dx = T(-1), T hh2 = T(-1)) {
   Local<T> o;
   const T dy = (T(2) * u1 - T(1)) * hh;
-  const T d_z = T(2) * hh * std::sqrt(u1 * (T(1) - u1));
+  const auto disk_z = [&] { return T(2) * hh * std::sqrt(u1 * (T(1) - u1)); };  // d_z (the ellipse may not need it)
   if (piece == 0) {
     const T wx = p.r_x * dx + p.c_x, wy = p.r_y * dy;
-    const T low = dx > T(0) ? p.cz_minus_rz + p.r_z * (hh * hh / (T(1) + dx)) : p.c_z - p.r_z * dx;
-    const T rest = p.r_y * d_z;
-    o.w = Vec3<T>(wx, wy, std::sqrt(low * low + rest * rest));
-    o.pdf_proj = T(1) / (inv_disk_density * (p.r_x * p.r_y));
+    T low;
+    if (one_minus_abs_dx >= T(0)) {
+      // c_z - r_z + r_z (1 - d_x) for d_x > 0, c_z + r_z |d_x| otherwise, with |d_x| = 1 - (1 - |d_x|) rounded as
+      // the cut disk rounds it: both as b + r_z v, b and v selected by a 0/1 weight t (exact: v = (1 - t) + (2 t - 1)
+      // (1 - |d_x|) is 1 - |d_x| or 1 - (1 - |d_x|)), without a branch on the random sign of d_x (the compiler kept
+      // one for a plain ?:) and with the selection of b done before 1 - |d_x| is known.
+      const T t = T(dx > T(0));
+      const T b = t * p.cz_minus_rz + (T(1) - t) * p.c_z;
+      low = b + p.r_z * ((T(1) - t) + (T(2) * t - T(1)) * one_minus_abs_dx);
+    } else {
+      low = dx > T(0) ? p.cz_minus_rz + p.r_z * (hh * hh / (T(1) + dx)) : p.c_z - p.r_z * dx;
+    }
+    T rest2;
+    if (hh2 >= T(0)) {
+      rest2 = (p.r_y * p.r_y) * (T(4) * (u1 * (T(1) - u1))) * hh2;  // (r_y d_z)^2, d_z^2 = 4 hh^2 u1 (1 - u1)
+    } else {
+      const T rest = p.r_y * disk_z();
+      rest2 = rest * rest;
+    }
+    const T height2 = low * low + rest2;
+    o.w = Vec3<T>(wx, wy, std::sqrt(height2));
+    o.norm2 = wx * wx + wy * wy + height2;
+    o.pdf_den = inv_disk_density * (p.r_x * p.r_y);
+    o.pdf_proj = T(1) / o.pdf_den;
   } else if (piece == 1) {
+    const T d_z = disk_z();
     o.w = Vec3<T>(-dx, dy, d_z);
-    o.pdf_proj = T(1) / inv_disk_density;
+    o.norm2 = o.w.squaredNorm();
+    o.pdf_den = inv_disk_density;
+    o.pdf_proj = T(1) / o.pdf_den;
   } else {
     // 1 - w_y^2 - w_z^2 = d_x^2 + (1 - s_y^2) d_y^2 + (1 - k^2) d_z^2 on the unit sphere: a sum of squares (header
     // comment), where 1 - w_y^2 - w_z^2 lost eps / w_x^2 of w_x's digits (a Case-3 sample pdf 2e-9 off at
     // w_x = 3.5e-4, fuzz_projected_cap_double 71f5a077; 2e-5 at w_x = 1.5e-6, 8b269b33; issue 7).
+    const T d_z = disk_z();
     const T w_z = p.k * d_z;
     const Case3Sy<T> sy = case3_sy(p, d_z);
     const T s_y = sy.s_y;
     const T w_y = s_y * dy;
-    const T w_x = std::sqrt(dx * dx + sy.one_minus_sy2 * (dy * dy) + p.one_minus_k2 * (d_z * d_z));
+    const T w_x2 = dx * dx + sy.one_minus_sy2 * (dy * dy) + p.one_minus_k2 * (d_z * d_z);
+    const T w_x = std::sqrt(w_x2);
     o.w = Vec3<T>(w_x, w_y, w_z);
+    o.norm2 = w_x2 + w_y * w_y + w_z * w_z;
     // Alg. 4: p = -t_y^2 / ((c_z + r_z)^2 A_D) w_x / (d_x s_y) = w_x / (k^2 s_y |d_x|) per unit disk density.
     // Where the lune has no width in T (s_y = 0) or d_x = 0 the density is not representable: 0, which the
     // sampler turns into "no sample" (it divided by zero, fuzz_projected_cap_double under UBSan, issue 7).
     const T den = inv_disk_density * (p.k * p.k) * s_y * std::abs(dx);
+    o.pdf_num = w_x, o.pdf_den = den;
     o.pdf_proj = den > T(0) ? w_x / den : T(0);
   }
   return o;
@@ -508,15 +592,7 @@ template <class T> bool local_to_disk(const ProjectedCapView<T>& p, int piece, c
   return std::abs(dy) <= hh && std::isfinite(area_factor) && area_factor > T(0);
 }
 
-// The pieces of a view, with their u0 ranges and left-area maps a = alpha + beta u0. With the exact inverse these
-// are Alg. 2-4's: ellipse a = u0 (A_E + A_D) / A_E * A_E' = u0 A_E' / tau, disk a = (1 - u0) A_D / (1 - tau)
-// (= total (1 - u0)), lune a = (1 - u0) A_D. With the quintic the same maps end at the left-areas where the
-// quintic reaches the cuts (quintic_area_*), so that the pieces meet exactly; tau is the same.
-template <class T> struct Piece {
-  int kind;
-  T u_lo, u_hi, alpha, beta;
-  T right_hi = T(0);  // pieces with alpha = 0: the right-area pi - a at u_hi, without cancellation
-};
+// The pieces of a view: see Piece (declared before ProjectedCapView, which stores the quintic's pieces).
 // Every piece's map is a = beta u0 (alpha = 0) or a = alpha (1 - u0) (alpha = -beta); the second is evaluated in
 // that form: 1 - u0 is exact for u0 >= 1/2, where a is small, and alpha + beta u0 cancels there (relative error
 // eps / (1 - u0) in a: 1.7e-3 in float at u0 = 1 - 3.6e-5, which moved float samples near the disk's edge and
@@ -600,20 +676,37 @@ DirectionSample<T> sample_projected_spherical_cap(const ProjectedCapView<T>& p, 
   using namespace projected_cap_detail;
   if (!p.valid()) return DirectionSample<T>::none(p.reason);
   if (!std::isfinite(u[0]) || !std::isfinite(u[1])) return DirectionSample<T>::none(NoSample::kNonFinite);
-  const T u0 = std::clamp(u[0], T(0), T(1)), u1 = std::clamp(u[1], T(0), T(1));
-  std::array<Piece<T>, 2> ps{};
-  const int n = pieces<T, M>(p, ps);
+  const T u0 = std::min(std::max(u[0], T(0)), T(1)), u1 = std::min(std::max(u[1], T(0)), T(1));  // clamps
+  constexpr bool stored = std::is_same_v<T, float> && M == CutDiskInverse::kQuintic;  // see quintic_pieces
+  std::array<Piece<T>, 2> formed{};
+  const std::array<Piece<T>, 2>& ps = stored ? p.quintic_pieces : formed;
+  int n = p.quintic_piece_count;
+  if constexpr (!stored) n = pieces<T, M>(p, formed);
   int i = 0;
   while (i + 1 < n && u0 >= ps[i].u_hi) ++i;  // Alg. 2's threshold xi_0 < A_E / (A_E + A_D)
   const Piece<T>& pc = ps[i];
   const CutDiskX<T> d = sample_cut_unit_disk_x<T, M>(piece_left_area(pc, u0), piece_right_area(pc, u0));  // Alg. 5
-  const Local<T> loc = disk_to_local(p, pc.kind, d.x, d.half_height, u1, d.inv_density * std::abs(pc.beta));
-  const T pdf = loc.pdf_proj * loc.w.z();
-  if (!(pdf > T(0)) || !std::isfinite(pdf)) return DirectionSample<T>::none(NoSample::kOnSilhouette);
-  DirectionSample<T> s;
-  s.direction = renormalized(p.to_world(loc.w));
-  s.pdf = pdf;
-  return s;
+  if constexpr (std::is_same_v<T, float> && M == CutDiskInverse::kQuintic) {
+    // float (issue 9's speed target): 1 - d_x = q from the cut disk (no division), the pdf by one division instead of
+    // two, and the renormalisation of a direction that is unit to rounding by one Newton step (core.h).
+    const Local<T> loc = disk_to_local(p, pc.kind, d.x, d.half_height, u1, d.inv_density * std::abs(pc.beta),
+                                       d.one_minus_abs_x, d.half_height2);
+    if (!(loc.pdf_den > T(0))) return DirectionSample<T>::none(NoSample::kOnSilhouette);
+    const T pdf = loc.pdf_num * loc.w.z() / loc.pdf_den;
+    if (!(pdf > T(0)) || !std::isfinite(pdf)) return DirectionSample<T>::none(NoSample::kOnSilhouette);
+    DirectionSample<T> s;
+    s.direction = p.to_world(loc.w) * near_unit_renormalization_factor(loc.norm2);
+    s.pdf = pdf;
+    return s;
+  } else {
+    const Local<T> loc = disk_to_local(p, pc.kind, d.x, d.half_height, u1, d.inv_density * std::abs(pc.beta));
+    const T pdf = loc.pdf_proj * loc.w.z();
+    if (!(pdf > T(0)) || !std::isfinite(pdf)) return DirectionSample<T>::none(NoSample::kOnSilhouette);
+    DirectionSample<T> s;
+    s.direction = renormalized(p.to_world(loc.w));
+    s.pdf = pdf;
+    return s;
+  }
 }
 
 template <class T, CutDiskInverse M = CutDiskInverse::kQuintic>

@@ -131,3 +131,46 @@ TEST(CubeRoot, IsWithinHalfAnUlpInFloatAndOneUlpInDouble) {
   EXPECT_EQ(warpcheck::cube_root(-8.0), -2.0);
   EXPECT_TRUE(std::isnan(warpcheck::cube_root(std::numeric_limits<double>::quiet_NaN())));
 }
+
+// core.h's division-free x^(2/3) for float (the float projected-cap quintic's root, issue 9) against cbrtl, over every
+// float of one period [1, 8): its steps scale exactly with x -> 8 x (checked below across the exponent range where
+// x and the result are normal floats), so this covers every such float. Measured: 0.5228 ulp (cube_root(x * x),
+// which it replaced for float, rounds x * x first).
+TEST(CubeRootSquaredForFloat, IsWithinAnUlpOverEveryFloatOfOnePeriodAndScalesExactlyByEight) {
+  double worst = 0;
+  for (float x = 1.0f; x < 8.0f; x = std::nextafter(x, 9.0f)) {
+    const long double c = cbrtl((long double)x), ref = c * c;
+    const float fr = float(ref);
+    const long double ulp = std::nextafter(fr, std::numeric_limits<float>::infinity()) - fr;
+    worst = std::max(worst, double(std::abs((long double)warpcheck::cube_root_squared_for_float(x) - ref) / ulp));
+  }
+  std::printf("cube_root_squared_for_float: worst %.4f ulp over [1, 8)\n", worst);
+  EXPECT_LE(worst, 0.53);
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<float> m(1.0f, 8.0f);
+  for (int i = 0; i < 20000; ++i) {
+    const float x = m(rng);
+    const int k = int(rng() % 83) - 41;  // 8^k x and (8^k x)^(2/3) = 4^k x^(2/3) normal floats
+    EXPECT_EQ(warpcheck::cube_root_squared_for_float(std::ldexp(x, 3 * k)),
+              std::ldexp(warpcheck::cube_root_squared_for_float(x), 2 * k)) << x << " " << k;
+  }
+  EXPECT_EQ(warpcheck::cube_root_squared_for_float(0.0f), 0.0f);
+  EXPECT_EQ(warpcheck::cube_root_squared_for_float(-8.0f), 4.0f);  // outside: std::cbrt
+  EXPECT_TRUE(std::isnan(warpcheck::cube_root_squared_for_float(std::numeric_limits<float>::quiet_NaN())));
+}
+
+// core.h's renormalisation factor (3 - n2) / 2 against 1 / sqrt(n2), over every float n2 within 2^-12 of 1, where it
+// is used (one Newton step: relative error 3/8 (n2 - 1)^2 <= 2.2e-8 plus its roundings); beyond, 1 / sqrt(n2).
+TEST(NearUnitRenormalization, IsWithinAnUlpOfTheInverseSquareRootForEveryFloatWithin2ToTheMinus12OfOne) {
+  double worst = 0;
+  const float lo = 1.0f - 0x1p-12f, hi = 1.0f + 0x1p-12f;
+  for (float n2 = lo; n2 <= hi; n2 = std::nextafter(n2, 2.0f)) {
+    const long double ref = 1 / std::sqrt((long double)n2);
+    const float fr = float(ref);
+    const long double ulp = std::nextafter(fr, 2.0f) - fr;
+    worst = std::max(worst, double(std::abs((long double)warpcheck::near_unit_renormalization_factor(n2) - ref) / ulp));
+  }
+  std::printf("near_unit_renormalization_factor: worst %.4f ulp\n", worst);
+  EXPECT_LE(worst, 1.0);
+  EXPECT_EQ(warpcheck::near_unit_renormalization_factor(4.0f), 0.5f);  // far from 1: 1 / sqrt
+}
