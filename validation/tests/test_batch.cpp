@@ -3,6 +3,7 @@
 // battery (validate(), 200k samples, fixed seed, Holm at alpha = 0.01) when the battery draws through it.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <random>
 #include <vector>
 
@@ -75,9 +76,10 @@ TYPED_TEST(Batch, SphereSolidAngleBatchDeclinesLikeTheScalarKernelAndNeverOutput
   }
 }
 
-// The battery, drawing every sample through the batch (one primary sample per call: the same code path, in
-// a block of one, as the vectorised loop's remainder handling). Default tolerance (1e-6) in float too, as the
-// registry uses for the scalar float sphere kernels.
+// The battery, drawing every sample through the batch: each primary sample fills a whole block of 128 lanes
+// (batch.h's kBlock), so that the vectorised loops compute it, not the scalar remainder a block of one would take,
+// and every lane must agree with lane 0 bit for bit. Default tolerance (1e-6) in float too, as the registry uses
+// for the scalar float sphere kernels.
 template <class T> validation::SamplerUnderTest batch_sampler(const SphereLightGeometry<validation::Real>& g) {
   using validation::Real;
   SphereLightGeometry<T> gt{ShadingPoint<T>{g.shading.position.template cast<T>(), g.shading.normal.template cast<T>()},
@@ -88,10 +90,16 @@ template <class T> validation::SamplerUnderTest batch_sampler(const SphereLightG
   s.scalar = validation::scalar_name<T>();
   s.config = "batch";
   s.sample = [v](double u0, double u1) {
-    const T a = validation::to_unit<T>(u0), b = validation::to_unit<T>(u1);
-    T x, y, z, pdf;
-    const NoSample r = sample_sphere_solid_angle_batch(v, &a, &b, 1, DirectionBatch<T>{&x, &y, &z, &pdf});
-    return validation::Sample{validation::Vec3L(x, y, z), Real(pdf), r == NoSample::kNone};
+    constexpr std::size_t kLanes = 128;
+    std::array<T, kLanes> a, b, x, y, z, pdf;
+    a.fill(validation::to_unit<T>(u0)), b.fill(validation::to_unit<T>(u1));
+    const NoSample r = sample_sphere_solid_angle_batch(v, a.data(), b.data(), kLanes,
+                                                       DirectionBatch<T>{x.data(), y.data(), z.data(), pdf.data()});
+    bool lanes_agree = true;
+    for (std::size_t i = 1; i < kLanes; ++i)
+      lanes_agree = lanes_agree && x[i] == x[0] && y[i] == y[0] && z[i] == z[0] && pdf[i] == pdf[0];
+    // A lane that disagrees is reported as a declined sample, which fails the battery's pdf-consistency.
+    return validation::Sample{validation::Vec3L(x[0], y[0], z[0]), Real(pdf[0]), r == NoSample::kNone && lanes_agree};
   };
   s.reference_sample = [g](Real u0, Real u1) {
     const SphereView<Real> vr = make_sphere_view(g);
