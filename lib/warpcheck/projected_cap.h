@@ -662,7 +662,12 @@ template <class T, CutDiskInverse M> T pdf_local(const ProjectedCapView<T>& p, c
       (*u)[0] = std::clamp(pc.alpha == T(0) ? pre.left_area / pc.beta : T(1) - pre.left_area / pc.alpha, pc.u_lo, pc.u_hi);
       (*u)[1] = hh > T(0) ? std::clamp((dy / hh + T(1)) / T(2), T(0), T(1)) : T(0.5);
     }
-    return pre.density / (std::abs(pc.beta) * area);
+    // |beta| area underflows to 0 for a piece whose left-area scale is subnormal (a float lune piece with
+    // alpha = 9e-44, fuzz_projected_cap_float aad9b177, issue 9's float path moved a grazing sample into it): the
+    // density there is not representable. 0, which the callers made of the infinite quotient before, without the
+    // division by zero.
+    const T den = std::abs(pc.beta) * area;
+    return den > T(0) ? pre.density / den : T(0);
   }
   return T(0);
 }
