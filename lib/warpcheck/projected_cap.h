@@ -682,36 +682,34 @@ DirectionSample<T> sample_projected_spherical_cap(const ProjectedCapView<T>& p, 
   if (!p.valid()) return DirectionSample<T>::none(p.reason);
   if (!std::isfinite(u[0]) || !std::isfinite(u[1])) return DirectionSample<T>::none(NoSample::kNonFinite);
   const T u0 = std::min(std::max(u[0], T(0)), T(1)), u1 = std::min(std::max(u[1], T(0)), T(1));  // clamps
-  constexpr bool stored = std::is_same_v<T, float> && M == CutDiskInverse::kQuintic;  // see quintic_pieces
+  // float with the quintic (issue 9's speed target): the pieces stored in the view (see quintic_pieces), and below
+  // 1 - d_x = q from the cut disk (no division), the pdf by one division instead of two, and the renormalisation of
+  // a direction that is unit to rounding by one Newton step (core.h). Double and long double keep the earlier path
+  // (disk_to_local's defaults -1: 1 - d_x and hh^2 unknown).
+  constexpr bool fast = std::is_same_v<T, float> && M == CutDiskInverse::kQuintic;
   std::array<Piece<T>, 2> formed{};
-  const std::array<Piece<T>, 2>& ps = stored ? p.quintic_pieces : formed;
+  const std::array<Piece<T>, 2>& ps = fast ? p.quintic_pieces : formed;
   int n = p.quintic_piece_count;
-  if constexpr (!stored) n = pieces<T, M>(p, formed);
+  if constexpr (!fast) n = pieces<T, M>(p, formed);
   int i = 0;
   while (i + 1 < n && u0 >= ps[i].u_hi) ++i;  // Alg. 2's threshold xi_0 < A_E / (A_E + A_D)
   const Piece<T>& pc = ps[i];
   const CutDiskX<T> d = sample_cut_unit_disk_x<T, M>(piece_left_area(pc, u0), piece_right_area(pc, u0));  // Alg. 5
-  if constexpr (std::is_same_v<T, float> && M == CutDiskInverse::kQuintic) {
-    // float (issue 9's speed target): 1 - d_x = q from the cut disk (no division), the pdf by one division instead of
-    // two, and the renormalisation of a direction that is unit to rounding by one Newton step (core.h).
-    const Local<T> loc = disk_to_local(p, pc.kind, d.x, d.half_height, u1, d.inv_density * std::abs(pc.beta),
-                                       d.one_minus_abs_x, d.half_height2);
+  const Local<T> loc = disk_to_local(p, pc.kind, d.x, d.half_height, u1, d.inv_density * std::abs(pc.beta),
+                                     fast ? d.one_minus_abs_x : T(-1), fast ? d.half_height2 : T(-1));
+  T pdf;
+  if constexpr (fast) {
     if (!(loc.pdf_den > T(0))) return DirectionSample<T>::none(NoSample::kOnSilhouette);
-    const T pdf = loc.pdf_num * loc.w.z() / loc.pdf_den;
-    if (!(pdf > T(0)) || !std::isfinite(pdf)) return DirectionSample<T>::none(NoSample::kOnSilhouette);
-    DirectionSample<T> s;
-    s.direction = p.to_world(loc.w) * near_unit_renormalization_factor(loc.norm2);
-    s.pdf = pdf;
-    return s;
+    pdf = loc.pdf_num * loc.w.z() / loc.pdf_den;
   } else {
-    const Local<T> loc = disk_to_local(p, pc.kind, d.x, d.half_height, u1, d.inv_density * std::abs(pc.beta));
-    const T pdf = loc.pdf_proj * loc.w.z();
-    if (!(pdf > T(0)) || !std::isfinite(pdf)) return DirectionSample<T>::none(NoSample::kOnSilhouette);
-    DirectionSample<T> s;
-    s.direction = renormalized(p.to_world(loc.w));
-    s.pdf = pdf;
-    return s;
+    pdf = loc.pdf_proj * loc.w.z();
   }
+  if (!(pdf > T(0)) || !std::isfinite(pdf)) return DirectionSample<T>::none(NoSample::kOnSilhouette);
+  DirectionSample<T> s;
+  if constexpr (fast) s.direction = p.to_world(loc.w) * near_unit_renormalization_factor(loc.norm2);
+  else s.direction = renormalized(p.to_world(loc.w));
+  s.pdf = pdf;
+  return s;
 }
 
 template <class T, CutDiskInverse M = CutDiskInverse::kQuintic>
