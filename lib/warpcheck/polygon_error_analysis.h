@@ -70,8 +70,7 @@ template <class T> T projected_azimuth_cdf(const PolygonProjectedView<T>& v, con
     const T c0 = kahan_cross2(s.s0, w), c1 = kahan_cross2(w, s.s1);
     const Vec2<T> half = s.s0 / s.s0.norm() + s.s1 / s.s1.norm();
     if (c0 >= T(0) && c1 >= T(0) && half.dot(w) >= T(0)) {
-      T part = ellipse_sector_area<T>(s.outer, s.s0, w, c0);
-      if (s.decentral) part -= ellipse_sector_area<T>(s.inner, s.s0, w, c0);
+      const T part = s.decentral ? decentral_area_to<T>(s, w) : ellipse_sector_area<T>(s.outer, s.s0, w, c0);
       return (acc + std::clamp(part, T(0), s.area)) / v.projected_solid_angle;
     }
     acc += s.area;
