@@ -15,11 +15,13 @@
 //                   horizontal at height 1 above the plane z = 0 (normal +z). Central (the polygon contains
 //                   the zenith, Fig. 3): shading points uniform in the disk of radius 0.3 below its centre.
 //                   Decentral: shading points at horizontal distance 2 to 4 from its centre.
-// Kernels the papers do not time (no target; in the JSON for the report): polygon_ltc, the polygon scenes with
-// the battery's "random" LTC (registry_sptd.cpp) with its third row set to (0, 0, 1), so that M^-1 keeps every
-// light above the horizon (with the row -0.37, 0.075, 1 about 21% of the decentral lights had no sample), and sptd_uniform_cap / sptd_cosine_cap, the sphere scenes' caps
-// (the light's cone from the shading point) under an SPTD with pivot (0.2, 0.1, 0.5) in world space (|r_p| 0.55)
-// and, for the clamped cosine, base axis +z.
+// Kernels the papers do not time (no target; in the JSON for the report):
+//  polygon_ltc      the polygon scenes with the battery's "random" LTC (registry_sptd.cpp), its third row set to
+//                   (0, 0, 1) so that M^-1 keeps every light above the horizon (with the row -0.37, 0.075, 1 about
+//                   21% of the decentral lights had no sample);
+//  sptd_uniform_cap / sptd_cosine_cap   the sphere scenes' caps (the light's cone from the shading point) under an
+//                   SPTD with pivot (0.2, 0.1, 0.5) in world space (|r_p| 0.55) and, for the clamped cosine, base
+//                   axis +z.
 // Random numbers: pre-generated with std::mt19937_64 seed 1, as T, in [0, 1).
 #include <benchmark/benchmark.h>
 
