@@ -11,21 +11,21 @@
 #include <cstdio>
 #include <cstdlib>
 
-#define WARPCHECK_FUZZ_ENTRY(check)                                                  \
-  extern "C" int LLVMFuzzerInitialize(int*, char***) {                               \
-    WARPCHECK_FUZZ_ENABLE_TRAPS();                                                   \
-    return 0;                                                                        \
-  }                                                                                  \
+#define WARPCHECK_FUZZ_ENTRY(check)                                                   \
+  extern "C" int LLVMFuzzerInitialize(int*, char***) {                                \
+    WARPCHECK_FUZZ_ENABLE_TRAPS();                                                    \
+    return 0;                                                                         \
+  }                                                                                   \
   extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) { \
-    FuzzedDataProvider in(data, size);                                               \
-    try {                                                                            \
-      check(in);                                                                     \
-    } catch (const ::warpcheck::fuzz::InvariantViolation& e) {                       \
-      std::fputs(e.what(), stderr);                                                  \
-      std::fflush(stderr);                                                           \
-      std::abort();                                                                  \
-    }                                                                                \
-    return 0;                                                                        \
+    FuzzedDataProvider in(data, size);                                                \
+    try {                                                                             \
+      check(in);                                                                      \
+    } catch (const ::warpcheck::fuzz::InvariantViolation& e) {                        \
+      std::fputs(e.what(), stderr);                                                   \
+      std::fflush(stderr);                                                            \
+      std::abort();                                                                   \
+    }                                                                                 \
+    return 0;                                                                         \
   }
 
 #ifdef WARPCHECK_FUZZ_TRAP_FP

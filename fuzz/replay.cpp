@@ -1,12 +1,13 @@
 // fuzz/replay.cpp: the replay driver (plain main(), builds with g++, no libFuzzer). Runs inputs through the
 // same check_<family><T> code as the libFuzzer targets:
-//   warpcheck_fuzz_replay TARGET PATH... [--optional PATH...]     e.g.  warpcheck_fuzz_replay fuzz_sphere_double data/fuzz/fuzz_sphere_double/corpus
+//   warpcheck_fuzz_replay TARGET PATH... [--optional PATH...]     e.g.  warpcheck_fuzz_replay fuzz_sphere_double
+//   data/fuzz/fuzz_sphere_double/corpus
 // A PATH is a file or a directory (walked recursively; files ending in .triage are skipped). An input F with
 // a triage file F.triage whose first word is "known" (a documented limit of a float kernel or a finding in a
 // published baseline, not fixed on purpose) is replayed and its outcome printed but not asserted; every other
 // input must pass every invariant, and one triaged "open" fails whatever its outcome here (a sanitizer
-// finding does not reproduce without the sanitizers). A missing PATH is an error (a target without its corpus must not pass
-// vacuously, nor may one whose paths hold no input at all); paths after --optional may be missing (a target
+// finding does not reproduce without the sanitizers). A missing PATH is an error (a target without its corpus must not
+// pass vacuously, nor may one whose paths hold no input at all); paths after --optional may be missing (a target
 // without findings has no regressions/). Exit status: 0 when every asserted input passes; 1 otherwise. ctest runs one
 // "fuzz_replay.TARGET" test per target over data/fuzz/TARGET/{corpus,regressions} (label fast).
 #include <chrono>
@@ -26,7 +27,7 @@ using Check = std::function<void(FuzzedDataProvider&)>;
 
 static std::map<std::string, Check> targets() {
   std::map<std::string, Check> t;
-#define WARPCHECK_FUZZ_ADD(family)                                                                        \
+#define WARPCHECK_FUZZ_ADD(family)                                                                          \
   t["fuzz_" #family "_float"] = [](FuzzedDataProvider& in) { warpcheck::fuzz::check_##family<float>(in); }; \
   t["fuzz_" #family "_double"] = [](FuzzedDataProvider& in) { warpcheck::fuzz::check_##family<double>(in); };
   WARPCHECK_FUZZ_FAMILIES(WARPCHECK_FUZZ_ADD)

@@ -65,16 +65,15 @@ struct InvariantViolation : std::runtime_error {
 };
 
 // Formats the message and throws. `what` names the invariant; the stream gets the geometry.
-#define WARPCHECK_FUZZ_REQUIRE(cond, what, details)                                                     \
-  do {                                                                                                   \
-    if (!(cond)) {                                                                                       \
-      std::ostringstream warpcheck_fuzz_os;                                                              \
-      warpcheck_fuzz_os.precision(21);                                                                   \
-      warpcheck_fuzz_os << "warpcheck invariant violated: " << (what) << " [" << __FILE__ << ":" << __LINE__ \
-                        << "]\n"                                                                         \
-                        << details;                                                                      \
-      throw ::warpcheck::fuzz::InvariantViolation(warpcheck_fuzz_os.str());                              \
-    }                                                                                                    \
+#define WARPCHECK_FUZZ_REQUIRE(cond, what, details)                                                                   \
+  do {                                                                                                                \
+    if (!(cond)) {                                                                                                    \
+      std::ostringstream warpcheck_fuzz_os;                                                                           \
+      warpcheck_fuzz_os.precision(21);                                                                                \
+      warpcheck_fuzz_os << "warpcheck invariant violated: " << (what) << " [" << __FILE__ << ":" << __LINE__ << "]\n" \
+                        << details;                                                                                   \
+      throw ::warpcheck::fuzz::InvariantViolation(warpcheck_fuzz_os.str());                                           \
+    }                                                                                                                 \
   } while (0)
 
 template <class T> std::string show(const Vec3<T>& v) {
@@ -110,10 +109,31 @@ template <class T> T finite_or_zero(T t) { return kAllowNonFinite || std::isfini
 
 template <class T> T special_value(std::uint8_t i) {
   using L = std::numeric_limits<T>;
-  const T table[] = {T(0), -T(0), T(1), T(-1), T(0.5), T(2), T(-2), L::epsilon(), -L::epsilon(),
-                     T(1) + L::epsilon(), T(1) - L::epsilon() / 2, L::min(), -L::min(), L::denorm_min(),
-                     -L::denorm_min(), L::max(), L::lowest(), std::sqrt(L::max()), std::sqrt(L::min()),
-                     T(1e-30f), T(1e30f), L::infinity(), -L::infinity(), L::quiet_NaN(), -L::quiet_NaN()};
+  const T table[] = {T(0),
+                     -T(0),
+                     T(1),
+                     T(-1),
+                     T(0.5),
+                     T(2),
+                     T(-2),
+                     L::epsilon(),
+                     -L::epsilon(),
+                     T(1) + L::epsilon(),
+                     T(1) - L::epsilon() / 2,
+                     L::min(),
+                     -L::min(),
+                     L::denorm_min(),
+                     -L::denorm_min(),
+                     L::max(),
+                     L::lowest(),
+                     std::sqrt(L::max()),
+                     std::sqrt(L::min()),
+                     T(1e-30f),
+                     T(1e30f),
+                     L::infinity(),
+                     -L::infinity(),
+                     L::quiet_NaN(),
+                     -L::quiet_NaN()};
   return finite_or_zero(table[i % (sizeof(table) / sizeof(table[0]))]);
 }
 
@@ -151,10 +171,14 @@ template <class T> T unit_random(FuzzedDataProvider& in) {
   const std::uint8_t mode = in.ConsumeIntegral<std::uint8_t>();
   const int digits = std::numeric_limits<T>::digits;
   switch (mode % 8) {
-    case 0: return T(0);
-    case 1: return T(1) - std::numeric_limits<T>::epsilon() / 2;  // the largest value below 1
-    case 2: return std::ldexp(T(1), -in.ConsumeIntegralInRange<int>(1, digits + 100));
-    case 3: return T(1) - std::ldexp(T(1), -in.ConsumeIntegralInRange<int>(1, digits));
+    case 0:
+      return T(0);
+    case 1:
+      return T(1) - std::numeric_limits<T>::epsilon() / 2;  // the largest value below 1
+    case 2:
+      return std::ldexp(T(1), -in.ConsumeIntegralInRange<int>(1, digits + 100));
+    case 3:
+      return T(1) - std::ldexp(T(1), -in.ConsumeIntegralInRange<int>(1, digits));
     default: {
       const std::uint64_t b = in.ConsumeIntegral<std::uint64_t>() >> (64 - digits);
       return std::ldexp(T(b), -digits);
@@ -251,7 +275,9 @@ template <class T> ShadingPoint<T> decode_polygon_shading(FuzzedDataProvider& in
   const T size = (p.vertices[j1] - p.vertices[j]).norm();
   const T sz = std::isfinite(size) && size > T(0) ? size : T(1);
   switch (in.ConsumeIntegralInRange<int>(0, 7)) {
-    case 0: sp.position = vec3<T>(in, sz); break;
+    case 0:
+      sp.position = vec3<T>(in, sz);
+      break;
     case 1: {  // on the light (a convex combination), possibly just off its plane
       const T w = unit_random<T>(in);
       sp.position = polygon_centroid(p) * (T(1) - w) + p.vertices[j] * w + nhat * tiny<T>(in, sz);
@@ -264,28 +290,46 @@ template <class T> ShadingPoint<T> decode_polygon_shading(FuzzedDataProvider& in
       sp.position = p.vertices[j] + t * (p.vertices[j1] - p.vertices[j]) + nhat * off_plane + side * tiny<T>(in, sz);
       break;
     }
-    case 3: sp.position = near(in, p.vertices[j], sz); break;  // at a vertex
-    case 4: sp.position = polygon_centroid(p) + nhat * scalar<T>(in, sz); break;       // on the axis
+    case 3:
+      sp.position = near(in, p.vertices[j], sz);
+      break;  // at a vertex
+    case 4:
+      sp.position = polygon_centroid(p) + nhat * scalar<T>(in, sz);
+      break;  // on the axis
     case 5: {
       const Vec3<T> d = vec3<T>(in, sz);
       sp.position = polygon_centroid(p) + d * std::ldexp(T(1), in.ConsumeIntegralInRange<int>(0, 120));
       break;
     }
-    default: sp.position = polygon_centroid(p) + vec3<T>(in, sz); break;
+    default:
+      sp.position = polygon_centroid(p) + vec3<T>(in, sz);
+      break;
   }
   const Vec3<T> to_light = polygon_centroid(p) - sp.position;
   switch (in.ConsumeIntegralInRange<int>(0, 6)) {
-    case 0: sp.normal = vec3<T>(in); break;
-    case 1: sp.normal = nhat * scalar<T>(in); break;
-    case 2: sp.normal = perpendicular(in, to_light); break;
-    case 3: sp.normal = perpendicular(in, Vec3<T>(p.vertices[j] - sp.position)); break;  // vertex j on the horizon
+    case 0:
+      sp.normal = vec3<T>(in);
+      break;
+    case 1:
+      sp.normal = nhat * scalar<T>(in);
+      break;
+    case 2:
+      sp.normal = perpendicular(in, to_light);
+      break;
+    case 3:
+      sp.normal = perpendicular(in, Vec3<T>(p.vertices[j] - sp.position));
+      break;   // vertex j on the horizon
     case 4: {  // the great circle of edge j passes through the zenith
       const T a = scalar<T>(in), b = scalar<T>(in);
       sp.normal = a * (p.vertices[j] - sp.position) + b * (p.vertices[j1] - sp.position);
       break;
     }
-    case 5: sp.normal = perpendicular(in, nhat); break;  // the light's plane contains the normal
-    default: sp.normal = near(in, safe_normalized(to_light)); break;
+    case 5:
+      sp.normal = perpendicular(in, nhat);
+      break;  // the light's plane contains the normal
+    default:
+      sp.normal = near(in, safe_normalized(to_light));
+      break;
   }
   return sp;
 }
@@ -311,13 +355,15 @@ inline constexpr long double kSubnormalUlps = 16;
 // header comment). P: the points' type (T, or L for points computed in long double); T: the kernel's precision.
 // subnormal_ulps: kSubnormalUlps, or 0 for a kernel that rescales V - x by a power of two before any other
 // arithmetic (no subnormal intermediate from the coordinates' magnitude; the caller derives it).
-template <class P, class T = P> L kappa_of(const Vec3<P>* v, int n, const Vec3<P>& x, L subnormal_ulps = kSubnormalUlps) {
+template <class P, class T = P>
+L kappa_of(const Vec3<P>* v, int n, const Vec3<P>& x, L subnormal_ulps = kSubnormalUlps) {
   L k = 1;
   const Vec3<L> xl = x.template cast<L>();
   for (int i = 0; i < n; ++i) {
     const Vec3<L> vl = v[i].template cast<L>();
     const L dist = (vl - xl).norm();
-    const L mag = vl.cwiseAbs().maxCoeff() + xl.cwiseAbs().maxCoeff() + subnormal_ulps * L(std::numeric_limits<T>::min());
+    const L mag =
+        vl.cwiseAbs().maxCoeff() + xl.cwiseAbs().maxCoeff() + subnormal_ulps * L(std::numeric_limits<T>::min());
     k = std::max(k, dist > 0 ? mag / dist : std::numeric_limits<L>::infinity());
   }
   return k;
@@ -338,13 +384,15 @@ L polygon_cone_margin(const PolygonLight<P>& p, const Vec3<P>& x, const Vec3<P>&
   Vec3<L> area = Vec3<L>::Zero();
   const Vec3<L> v0 = p.vertices[0].template cast<L>();
   for (int i = 1; i + 1 < n; ++i)
-    area += kahan_cross<L>(Vec3<L>(p.vertices[i].template cast<L>() - v0), Vec3<L>(p.vertices[i + 1].template cast<L>() - v0));
+    area += kahan_cross<L>(Vec3<L>(p.vertices[i].template cast<L>() - v0),
+                           Vec3<L>(p.vertices[i + 1].template cast<L>() - v0));
   const L h = area.dot(Vec3<L>(v0 - xl));
   auto margin_for = [&](L orient) {
     L margin = std::numeric_limits<L>::infinity();
     for (int j = 0; j < n; ++j) {
       const Vec3<L> pj = p.vertices[j].template cast<L>() - xl;
-      const Vec3<L> ej = edges ? edges[j] : Vec3<L>(p.vertices[(j + 1) % n].template cast<L>() - p.vertices[j].template cast<L>());
+      const Vec3<L> ej =
+          edges ? edges[j] : Vec3<L>(p.vertices[(j + 1) % n].template cast<L>() - p.vertices[j].template cast<L>());
       const Vec3<L> m = kahan_cross<L>(pj, ej);  // = p_j x p_{j+1}
       const L mn = m.norm();
       if (!(mn > 0)) continue;  // x on the edge's line: that bound is undetermined
@@ -360,7 +408,8 @@ L polygon_cone_margin(const PolygonLight<P>& p, const Vec3<P>& x, const Vec3<P>&
   // (from a point on the light it covers a whole hemisphere, and which one flips with a rounding error), so
   // either orientation is accepted.
   L mag = xl.cwiseAbs().maxCoeff();
-  for (int j = 0; j < n; ++j) mag = std::max(mag, L(p.vertices[j].template cast<L>().cwiseAbs().maxCoeff()) + xl.cwiseAbs().maxCoeff());
+  for (int j = 0; j < n; ++j)
+    mag = std::max(mag, L(p.vertices[j].template cast<L>().cwiseAbs().maxCoeff()) + xl.cwiseAbs().maxCoeff());
   const L an = area.norm();
   if (an > 0 && std::abs(h) / an <= L(kTolUlps) * eps<T>() * (mag + kSubnormalUlps * L(std::numeric_limits<T>::min())))
     return std::max(margin_for(L(1)), margin_for(L(-1)));
@@ -376,7 +425,8 @@ template <class T> void check_sample_shape(const DirectionSample<T>& s, const st
                            geometry << "reason " << to_string(s.reason) << " pdf " << s.pdf << "\n");
     return;
   }
-  WARPCHECK_FUZZ_REQUIRE(all_finite(s.direction), "non-finite direction", geometry << "direction " << show(s.direction) << "\n");
+  WARPCHECK_FUZZ_REQUIRE(all_finite(s.direction), "non-finite direction",
+                         geometry << "direction " << show(s.direction) << "\n");
   const L len = s.direction.template cast<L>().norm();
   WARPCHECK_FUZZ_REQUIRE(std::abs(len - 1) <= 16 * eps<T>(), "direction not unit",
                          geometry << "direction " << show(s.direction) << " |w| - 1 = " << (len - 1) << "\n");
@@ -386,8 +436,8 @@ template <class T> void check_sample_shape(const DirectionSample<T>& s, const st
 
 // pdf(direction) of the kernel, compared with the sample's pdf to relative tolerance `rel`, or 0 when the
 // direction is within `tol` of the boundary (margin: the reference's signed angular distance, > 0 inside).
-template <class T> void check_pdf_consistency(T sample_pdf, T eval_pdf, L rel, L margin, L tol,
-                                              const std::string& geometry) {
+template <class T>
+void check_pdf_consistency(T sample_pdf, T eval_pdf, L rel, L margin, L tol, const std::string& geometry) {
   WARPCHECK_FUZZ_REQUIRE(std::isfinite(eval_pdf) && eval_pdf >= T(0), "pdf(direction) not finite and >= 0",
                          geometry << "pdf(direction) " << eval_pdf << "\n");
   if (eval_pdf == T(0)) {
@@ -415,9 +465,8 @@ template <class T> void check_pdf_consistency(T sample_pdf, T eval_pdf, L rel, L
 // less than 0.5 % within delta, i.e. everywhere except within delta of a jump. pdf(w) = 0: allowed within tol of
 // the light's boundary (margin <= tol, as in check_pdf_consistency) or when a probe is not 0 (within delta of
 // the support's edge). With delta >= 1/2 rad the comparison carries no information.
-template <class T, class Pdf>
-void check_pdf_consistency_probed(T sample_pdf, const Vec3<T>& w, Pdf&& pdf, L delta, L rel, L margin, L tol,
-                                  const std::string& geometry) {
+template <class T, class Pdf> void check_pdf_consistency_probed(T sample_pdf, const Vec3<T>& w, Pdf&& pdf, L delta,
+                                                                L rel, L margin, L tol, const std::string& geometry) {
   const T p0 = pdf(w);
   WARPCHECK_FUZZ_REQUIRE(std::isfinite(p0) && p0 >= T(0), "pdf(direction) not finite and >= 0",
                          geometry << "pdf(direction) " << p0 << "\n");
@@ -445,9 +494,10 @@ void check_pdf_consistency_probed(T sample_pdf, const Vec3<T>& w, Pdf&& pdf, L d
   if (allowed >= L(0.5)) return;
   const L ratio = L(sample_pdf) / L(p0);
   WARPCHECK_FUZZ_REQUIRE(std::abs(ratio - 1) <= allowed, "pdf(direction) disagrees with the sample's pdf",
-                         geometry << "sample pdf " << sample_pdf << " pdf(direction) " << p0 << " ratio - 1 " << (ratio - 1)
-                                  << " allowed " << allowed << " (probes " << probes[0] << " " << probes[1] << " "
-                                  << probes[2] << " " << probes[3] << " at radius " << delta << ")\n");
+                         geometry << "sample pdf " << sample_pdf << " pdf(direction) " << p0 << " ratio - 1 "
+                                  << (ratio - 1) << " allowed " << allowed << " (probes " << probes[0] << " "
+                                  << probes[1] << " " << probes[2] << " " << probes[3] << " at radius " << delta
+                                  << ")\n");
 }
 
 // ---- Negative controls ---------------------------------------------------------------------------------------

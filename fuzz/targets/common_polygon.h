@@ -52,7 +52,7 @@ inline L segment_distance(const Vec3<L>& a, const Vec3<L>& e, const Vec3<L>& x) 
 // zero area) and each vertex's signed distance d[k] from the plane through the centroid, in long double.
 struct PolygonLifts {
   Vec3<L> nh = Vec3<L>::Zero();
-  L area2 = 0;  // |area vector| = 2 area
+  L area2 = 0;                  // |area vector| = 2 area
   Vec3<L> c = Vec3<L>::Zero();  // the centroid
   std::array<L, kMaxPolygonVertices> d{};
 };
@@ -62,7 +62,8 @@ template <class P> PolygonLifts polygon_lifts(const PolygonLight<P>& p) {
   Vec3<L> area = Vec3<L>::Zero(), &c = r.c;
   const Vec3<L> v0 = p.vertices[0].template cast<L>();
   for (int i = 1; i + 1 < n; ++i)
-    area += kahan_cross<L>(Vec3<L>(p.vertices[i].template cast<L>() - v0), Vec3<L>(p.vertices[i + 1].template cast<L>() - v0));
+    area += kahan_cross<L>(Vec3<L>(p.vertices[i].template cast<L>() - v0),
+                           Vec3<L>(p.vertices[i + 1].template cast<L>() - v0));
   for (int i = 0; i < n; ++i) c += p.vertices[i].template cast<L>() / L(n);
   r.area2 = area.norm();
   if (!(r.area2 > 0) || n < 3) return r;
@@ -106,15 +107,17 @@ template <class T> PolygonLight<T> merge_short_edges(const PolygonLight<T>& p, c
   const int n = p.count;
   L mag = 0;
   for (int i = 0; i < n; ++i) mag = std::max(mag, L(p.vertices[i].template cast<L>().cwiseAbs().maxCoeff()));
-  const L delta = L(kTolUlps) * eps<T>() *
-                  (mag + L(x.template cast<L>().cwiseAbs().maxCoeff()) + kSubnormalUlps * L(std::numeric_limits<T>::min()));
+  const L delta =
+      L(kTolUlps) * eps<T>() *
+      (mag + L(x.template cast<L>().cwiseAbs().maxCoeff()) + kSubnormalUlps * L(std::numeric_limits<T>::min()));
   PolygonLight<T> m;
   for (int i = 0; i < n; ++i) {
     const Vec3<L> vi = p.vertices[i].template cast<L>();
     if (m.count > 0 && (vi - m.vertices[m.count - 1].template cast<L>()).norm() <= delta / 2) continue;
     m.vertices[m.count++] = p.vertices[i];
   }
-  while (m.count > 1 && (m.vertices[m.count - 1].template cast<L>() - m.vertices[0].template cast<L>()).norm() <= delta / 2)
+  while (m.count > 1 &&
+         (m.vertices[m.count - 1].template cast<L>() - m.vertices[0].template cast<L>()).norm() <= delta / 2)
     --m.count;
   return m;
 }
@@ -127,7 +130,8 @@ template <class T> L arc_distance(const Vec3<T>& a, const Vec3<T>& b, const Vec3
   L d = std::min(angle(wl, ua), angle(wl, ub));
   const Vec3<L> nab = ua.cross(ub);
   const L nn = nab.norm();
-  if (nn > 0 && ua.cross(wl).dot(nab) >= 0 && wl.cross(ub).dot(nab) >= 0) d = std::min(d, std::abs(std::asin(std::clamp(nab.dot(wl) / nn, L(-1), L(1)))));
+  if (nn > 0 && ua.cross(wl).dot(nab) >= 0 && wl.cross(ub).dot(nab) >= 0)
+    d = std::min(d, std::abs(std::asin(std::clamp(nab.dot(wl) / nn, L(-1), L(1)))));
   return d;
 }
 
@@ -156,8 +160,9 @@ inline FlatMerge merge_flat_vertices(const PolygonLight<L>& flat, const std::arr
 // the light as given and its accepted displacements (merge_short_edges(light), a sliver's arc, the flat light, the
 // flat light merged, the flattened light with its credit; below), `inner` the smallest over the light as given, the
 // largest of the displacements' margins, and, off the plane beyond delta / 2, the flat light's own margin without
-// credit (80cce1ce below), and the flattened light's margin less its credit (e9b7708c below). A sample must lie inside some accepted displacement of the light (outer >= -tol); a
-// density of 0 needs w near the boundary of some accepted displacement (inner <= tol).
+// credit (80cce1ce below), and the flattened light's margin less its credit (e9b7708c below). A sample must lie inside
+// some accepted displacement of the light (outer >= -tol); a density of 0 needs w near the boundary of some accepted
+// displacement (inner <= tol).
 struct PolygonMargins {
   L inner, outer;
 };
@@ -171,7 +176,8 @@ template <class T> PolygonMargins polygon_margins(const PolygonLightGeometry<T>&
   if (merged.count >= 3 && merged.count < g.light.count) mm = polygon_cone_margin(merged, g.shading.position, w);
   // Merged down to a segment or a point: the light is within delta of it, so the accepted displacements' cones
   // are within the tolerance of its arc (a polygon of width 6 and length 1e30: a sliver).
-  if (merged.count == 1 || merged.count == 2) mm = -arc_distance(merged.vertices[0], merged.vertices[merged.count - 1], g.shading.position, w);
+  if (merged.count == 1 || merged.count == 2)
+    mm = -arc_distance(merged.vertices[0], merged.vertices[merged.count - 1], g.shading.position, w);
   // Other accepted displacements: a light within delta / 2 of a segment (a sliver: its width, the largest
   // distance of a vertex from the line through its two farthest vertices, is at most delta / 2) is measured
   // against that segment's arc; a light within delta / 2 of its plane against its vertices moved onto the
@@ -183,7 +189,8 @@ template <class T> PolygonMargins polygon_margins(const PolygonLightGeometry<T>&
     const Vec3<L> xl = g.shading.position.template cast<L>();
     L mag = 0;
     for (int i = 0; i < n; ++i) mag = std::max(mag, L(g.light.vertices[i].template cast<L>().cwiseAbs().maxCoeff()));
-    const L delta = L(kTolUlps) * eps<T>() * (mag + xl.cwiseAbs().maxCoeff() + kSubnormalUlps * L(std::numeric_limits<T>::min()));
+    const L delta =
+        L(kTolUlps) * eps<T>() * (mag + xl.cwiseAbs().maxCoeff() + kSubnormalUlps * L(std::numeric_limits<T>::min()));
     int ia = 0, ib = 0;
     L diam = 0;
     for (int i = 0; i < n; ++i)
@@ -194,8 +201,10 @@ template <class T> PolygonMargins polygon_margins(const PolygonLightGeometry<T>&
     if (diam > 0) {
       const Vec3<L> a = g.light.vertices[ia].template cast<L>(), e = g.light.vertices[ib].template cast<L>() - a;
       L width = 0;
-      for (int i = 0; i < n; ++i) width = std::max(width, kahan_cross<L>(Vec3<L>(g.light.vertices[i].template cast<L>() - a), e).norm() / diam);
-      if (width <= delta / 2) mm = std::max(mm, -arc_distance(g.light.vertices[ia], g.light.vertices[ib], g.shading.position, w));
+      for (int i = 0; i < n; ++i)
+        width = std::max(width, kahan_cross<L>(Vec3<L>(g.light.vertices[i].template cast<L>() - a), e).norm() / diam);
+      if (width <= delta / 2)
+        mm = std::max(mm, -arc_distance(g.light.vertices[ia], g.light.vertices[ib], g.shading.position, w));
     }
     const PolygonLifts lifts = polygon_lifts(g.light);
     const L an = lifts.area2;
@@ -261,7 +270,8 @@ template <class T> PolygonMargins polygon_margins(const PolygonLightGeometry<T>&
         auto within_r = [&](int i, int j) {  // vertices i and j, j before i going around, within r
           Vec3<L> f = Vec3<L>::Zero();
           for (int k = j; k != i; k = (k + 1) % n) f += fe[k];
-          return (g.light.vertices[i].template cast<L>() - g.light.vertices[j].template cast<L>()).norm() <= r || f.norm() <= r;
+          return (g.light.vertices[i].template cast<L>() - g.light.vertices[j].template cast<L>()).norm() <= r ||
+                 f.norm() <= r;
         };
         std::array<bool, kMaxPolygonVertices> kept{};
         int last = 0;
@@ -272,7 +282,8 @@ template <class T> PolygonMargins polygon_margins(const PolygonLightGeometry<T>&
         }
         for (int i = n - 1; i > 0 && within_r(0, i); --i) kept[i] = false;
         const FlatMerge fm = merge_flat_vertices(flat, fe, kept);
-        if (fm.light.count >= 3 && fm.light.count < n) mm = std::max(mm, polygon_cone_margin<L, T>(fm.light, xl, wl, fm.edges.data()));
+        if (fm.light.count >= 3 && fm.light.count < n)
+          mm = std::max(mm, polygon_cone_margin<L, T>(fm.light, xl, wl, fm.edges.data()));
       }
       // A light farther off its plane than that, but within check_polygon's planarity tolerance, is accepted as
       // the planar light it is near (polygon_planarity_tolerance, polygon.h; every kernel takes its side and its
@@ -360,20 +371,22 @@ void check_polygon_kernel(FuzzedDataProvider& in, const PolygonLightGeometry<T>&
     if (!s.valid()) continue;
     WARPCHECK_FUZZ_REQUIRE(valid_polygon, "a sample from a polygon that check_polygon rejects", geo);
     const PolygonMargins margins = polygon_margins(g, s.direction, clipped);
-    WARPCHECK_FUZZ_REQUIRE(margins.outer >= -tol, "direction outside the polygon",
-                           geo << "direction " << show(s.direction) << " margin " << margins.outer << " tol " << tol << "\n");
+    WARPCHECK_FUZZ_REQUIRE(
+        margins.outer >= -tol, "direction outside the polygon",
+        geo << "direction " << show(s.direction) << " margin " << margins.outer << " tol " << tol << "\n");
     L rel = 8 * eps<T>();
     if (density == PolygonDensity::kCosine || density == PolygonDensity::kArea) {
       // The cosine both densities are computed from (shading normal resp. light normal, in T).
-      const Vec3<T> axis = density == PolygonDensity::kCosine ? Vec3<T>(g.shading.normal) : polygon_area_vector(g.light);
+      const Vec3<T> axis =
+          density == PolygonDensity::kCosine ? Vec3<T>(g.shading.normal) : polygon_area_vector(g.light);
       const L c = std::abs(axis.template cast<L>().normalized().dot(s.direction.template cast<L>()));
       rel = c > 0 ? rel * (density == PolygonDensity::kArea ? 3 : 1) / c : L(1);
     }
     check_pdf_consistency<T>(s.pdf, pdf(s.direction), rel, margins.inner, tol, geo);
   }
   // The density at an arbitrary unit direction: finite, >= 0, zero for invalid geometry and well outside.
-  const Vec3<T> w = safe_normalized(in.ConsumeBool() ? vec3<T>(in)
-                                                     : Vec3<T>(polygon_centroid(g.light) - g.shading.position + vec3<T>(in)));
+  const Vec3<T> w = safe_normalized(
+      in.ConsumeBool() ? vec3<T>(in) : Vec3<T>(polygon_centroid(g.light) - g.shading.position + vec3<T>(in)));
   const T p = pdf(w);
   const std::string geo = describe(g, Vec2<T>(Vec2<T>::Zero()), name) + "pdf at w " + show(w) + "\n";
   WARPCHECK_FUZZ_REQUIRE(std::isfinite(p) && p >= T(0), "pdf not finite and >= 0", geo << "pdf " << p << "\n");

@@ -20,20 +20,33 @@ template <class T> SphereLightGeometry<T> decode_sphere(FuzzedDataProvider& in) 
   const Vec3<T> dir = safe_normalized(vec3<T>(in));
   const Vec3<T> unit_dir = dir.isZero() ? Vec3<T>(T(0), T(0), T(1)) : dir;
   switch (in.ConsumeIntegralInRange<int>(0, 4)) {
-    case 0: g.shading.position = vec3<T>(in, s); break;
-    case 1: g.shading.position = g.light.center + unit_dir * (r * (T(1) + tiny<T>(in, T(1)))); break;  // on the surface
-    case 2: g.shading.position = g.light.center + unit_dir * (r * std::ldexp(T(1), in.ConsumeIntegralInRange<int>(0, 120))); break;
-    default: g.shading.position = g.light.center + vec3<T>(in, std::isfinite(r) && r != T(0) ? std::abs(r) : T(1)); break;
+    case 0:
+      g.shading.position = vec3<T>(in, s);
+      break;
+    case 1:
+      g.shading.position = g.light.center + unit_dir * (r * (T(1) + tiny<T>(in, T(1))));
+      break;  // on the surface
+    case 2:
+      g.shading.position = g.light.center + unit_dir * (r * std::ldexp(T(1), in.ConsumeIntegralInRange<int>(0, 120)));
+      break;
+    default:
+      g.shading.position = g.light.center + vec3<T>(in, std::isfinite(r) && r != T(0) ? std::abs(r) : T(1));
+      break;
   }
   const Vec3<T> to_c = g.light.center - g.shading.position;
   switch (in.ConsumeIntegralInRange<int>(0, 4)) {
-    case 0: g.shading.normal = vec3<T>(in); break;
-    case 1: g.shading.normal = perpendicular(in, to_c); break;
+    case 0:
+      g.shading.normal = vec3<T>(in);
+      break;
+    case 1:
+      g.shading.normal = perpendicular(in, to_c);
+      break;
     case 2: {  // the cone exactly tangent to the horizon (from above or below): n.axis = -+ sin(theta_max)
       const T d = to_c.norm();
       const T sn = d > T(0) ? r / d : T(0);
       const T sign = in.ConsumeBool() ? T(1) : T(-1);
-      g.shading.normal = safe_normalized(to_c) * (sign * sn) + perpendicular(in, to_c) * std::sqrt(std::max(T(0), T(1) - sn * sn));
+      g.shading.normal =
+          safe_normalized(to_c) * (sign * sn) + perpendicular(in, to_c) * std::sqrt(std::max(T(0), T(1) - sn * sn));
       break;
     }
     default: {
@@ -49,8 +62,8 @@ template <class T> std::string describe(const SphereLightGeometry<T>& g, const V
   std::ostringstream os;
   os.precision(std::numeric_limits<T>::max_digits10);
   os << kernel << " <" << (sizeof(T) == 4 ? "float" : "double") << ">: center " << show(g.light.center) << " radius "
-     << g.light.radius << " x " << show(g.shading.position) << " n " << show(g.shading.normal) << " u (" << u[0]
-     << ", " << u[1] << ")\n";
+     << g.light.radius << " x " << show(g.shading.position) << " n " << show(g.shading.normal) << " u (" << u[0] << ", "
+     << u[1] << ")\n";
   return os.str();
 }
 
@@ -73,7 +86,8 @@ struct SphereReference {
   L kappa, d, r, cos_max, tol;
 };
 // subnormal_ulps: kappa_of's.
-template <class T> SphereReference sphere_reference(const SphereLightGeometry<T>& g, L subnormal_ulps = kSubnormalUlps) {
+template <class T>
+SphereReference sphere_reference(const SphereLightGeometry<T>& g, L subnormal_ulps = kSubnormalUlps) {
   SphereReference s;
   const Vec3<T> c = g.light.center;
   s.kappa = kappa_of<T>(&c, 1, g.shading.position, subnormal_ulps);

@@ -64,7 +64,8 @@ template <class T> Mat3<T> decode_ltc_matrix(FuzzedDataProvider& in) {
     }
     case 3: {  // near-singular: R1 diag(1, s1, s2) R2, s = 2^-k down to below eps
       const Mat3<T> r1 = rotation_from<T>(in), r2 = rotation_from<T>(in);
-      const int k1 = in.ConsumeIntegralInRange<int>(0, digits + 40), k2 = in.ConsumeIntegralInRange<int>(0, digits + 40);
+      const int k1 = in.ConsumeIntegralInRange<int>(0, digits + 40),
+                k2 = in.ConsumeIntegralInRange<int>(0, digits + 40);
       const Vec3<T> s(T(1), std::ldexp(T(1), -k1), std::ldexp(T(1), -k2));
       m = r1 * s.asDiagonal() * r2;
       break;
@@ -155,7 +156,8 @@ template <class T> LtcReference ltc_reference(const LtcPolygonGeometry<T>& g) {
   r.transformed.light.count = std::clamp(g.polygon.light.count, 0, kMaxPolygonVertices);
   const Vec3<L> x = g.polygon.shading.position.template cast<L>();
   for (int i = 0; i < r.transformed.light.count; ++i)
-    r.transformed.light.vertices[i] = r.m_inv * r.frame.to_local(Vec3<L>(g.polygon.light.vertices[i].template cast<L>() - x));
+    r.transformed.light.vertices[i] =
+        r.m_inv * r.frame.to_local(Vec3<L>(g.polygon.light.vertices[i].template cast<L>() - x));
   return r;
 }
 
@@ -259,15 +261,17 @@ template <class T> void check_ltc(FuzzedDataProvider& in, const Mutation& mutate
     const L tol = tol_at(s.direction);
     WARPCHECK_FUZZ_REQUIRE(pm.outer >= -tol, "direction outside the polygon or the LTC's support",
                            geo << "direction " << show(s.direction) << " margin " << pm.outer << " tol " << tol
-                               << " |E| " << ref.inverse_error << " sigma_1 / sigma_3 " << ref.sigma1 / ref.sigma3 << "\n");
+                               << " |E| " << ref.inverse_error << " sigma_1 / sigma_3 " << ref.sigma1 / ref.sigma3
+                               << "\n");
     const L radius = 2 * ref.inverse_error + e * ref.stretch(s.direction.template cast<L>().normalized());
     check_pdf_consistency_probed<T>(
         s.pdf, s.direction, [&](const Vec3<T>& w) { return mutate.pdf(pdf_ltc_polygon(view, w)); }, radius,
         16 * eps<T>(), pm.inner, tol, geo);
   }
   // The density at an arbitrary unit direction.
-  const Vec3<T> w = safe_normalized(in.ConsumeBool() ? vec3<T>(in)
-                                                     : Vec3<T>(polygon_centroid(g.polygon.light) - g.polygon.shading.position + vec3<T>(in)));
+  const Vec3<T> w = safe_normalized(
+      in.ConsumeBool() ? vec3<T>(in)
+                       : Vec3<T>(polygon_centroid(g.polygon.light) - g.polygon.shading.position + vec3<T>(in)));
   const T p = mutate.pdf(pdf_ltc_polygon(view, w));
   const std::string geo = describe(g, Vec2<T>(Vec2<T>::Zero()), "ltc_polygon pdf") + "w " + show(w) + "\n";
   WARPCHECK_FUZZ_REQUIRE(std::isfinite(p) && p >= T(0), "pdf not finite and >= 0", geo << "pdf " << p << "\n");

@@ -12,9 +12,9 @@ template <class T> void check_polygon_area(FuzzedDataProvider& in) {
   g.light = decode_polygon<T>(in);
   g.shading = decode_polygon_shading<T>(in, g.light);
   const TurkAreaView<T> v = make_turk_area_view(g);
-  check_polygon_kernel<T>(in, g, "polygon_area", false, PolygonDensity::kArea,
-                          [&](const Vec2<T>& u) { return sample_turk_area(v, u); },
-                          [&](const Vec3<T>& w) { return pdf_turk_area(g, w); });
+  check_polygon_kernel<T>(
+      in, g, "polygon_area", false, PolygonDensity::kArea, [&](const Vec2<T>& u) { return sample_turk_area(v, u); },
+      [&](const Vec3<T>& w) { return pdf_turk_area(g, w); });
 }
 
 }  // namespace warpcheck::fuzz

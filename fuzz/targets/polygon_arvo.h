@@ -12,9 +12,10 @@ template <class T> void check_polygon_arvo(FuzzedDataProvider& in) {
   g.light = decode_polygon<T>(in);
   g.shading = decode_polygon_shading<T>(in, g.light);
   const ArvoFanView<T> v = make_arvo_fan_view(g);
-  check_polygon_kernel<T>(in, g, "polygon_arvo", false, PolygonDensity::kConstant,
-                          [&](const Vec2<T>& u) { return sample_arvo_triangle_fan(v, u); },
-                          [&](const Vec3<T>& w) { return pdf_arvo_triangle_fan(g, w); });
+  check_polygon_kernel<T>(
+      in, g, "polygon_arvo", false, PolygonDensity::kConstant,
+      [&](const Vec2<T>& u) { return sample_arvo_triangle_fan(v, u); },
+      [&](const Vec3<T>& w) { return pdf_arvo_triangle_fan(g, w); });
 }
 
 }  // namespace warpcheck::fuzz

@@ -15,15 +15,17 @@ template <class T> void check_polygon_projected(FuzzedDataProvider& in) {
   const bool biased = in.ConsumeIntegralInRange<int>(0, 3) == 0;
   if (biased) {
     const PolygonProjectedView<T> v = make_polygon_projected_view<T, true>(g);
-    check_polygon_kernel<T>(in, g, "polygon_projected_biased", true, PolygonDensity::kCosine,
-                            [&](const Vec2<T>& u) { return sample_polygon_projected_solid_angle<T, true>(v, u, 0); },
-                            [&](const Vec3<T>& w) { return pdf_polygon_projected_solid_angle(v, w); });
+    check_polygon_kernel<T>(
+        in, g, "polygon_projected_biased", true, PolygonDensity::kCosine,
+        [&](const Vec2<T>& u) { return sample_polygon_projected_solid_angle<T, true>(v, u, 0); },
+        [&](const Vec3<T>& w) { return pdf_polygon_projected_solid_angle(v, w); });
   } else {
     const int iterations = in.ConsumeIntegralInRange<int>(0, 4);
     const PolygonProjectedView<T> v = make_polygon_projected_view<T, false>(g);
-    check_polygon_kernel<T>(in, g, "polygon_projected", true, PolygonDensity::kCosine,
-                            [&](const Vec2<T>& u) { return sample_polygon_projected_solid_angle<T, false>(v, u, iterations); },
-                            [&](const Vec3<T>& w) { return pdf_polygon_projected_solid_angle(g, w); });
+    check_polygon_kernel<T>(
+        in, g, "polygon_projected", true, PolygonDensity::kCosine,
+        [&](const Vec2<T>& u) { return sample_polygon_projected_solid_angle<T, false>(v, u, iterations); },
+        [&](const Vec3<T>& w) { return pdf_polygon_projected_solid_angle(g, w); });
   }
 }
 

@@ -13,9 +13,10 @@ template <class T> void check_polygon_solid_angle(FuzzedDataProvider& in) {
   g.shading = decode_polygon_shading<T>(in, g.light);
   const bool clipped = in.ConsumeBool();
   const PolygonSolidAngleView<T> v = make_polygon_solid_angle_view(g, clipped);
-  check_polygon_kernel<T>(in, g, clipped ? "polygon_solid_angle_clipped" : "polygon_solid_angle", clipped,
-                          PolygonDensity::kConstant, [&](const Vec2<T>& u) { return sample_polygon_solid_angle(v, u); },
-                          [&](const Vec3<T>& w) { return pdf_polygon_solid_angle(g, w, clipped); });
+  check_polygon_kernel<T>(
+      in, g, clipped ? "polygon_solid_angle_clipped" : "polygon_solid_angle", clipped, PolygonDensity::kConstant,
+      [&](const Vec2<T>& u) { return sample_polygon_solid_angle(v, u); },
+      [&](const Vec3<T>& w) { return pdf_polygon_solid_angle(g, w, clipped); });
 }
 
 }  // namespace warpcheck::fuzz

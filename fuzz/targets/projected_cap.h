@@ -39,11 +39,21 @@ template <class T> SphereLightGeometry<T> decode_projected_cap(FuzzedDataProvide
   const T ry = std::isfinite(d) && d > T(0) ? std::abs(g.light.radius) / d : T(0);
   T h = 0;
   switch (mode) {
-    case 1: h = ry * (T(1) + tiny<T>(in, T(1))); break;   // tangent from above, just off (Case 1/2)
-    case 2: h = -ry * (T(1) + tiny<T>(in, T(1))); break;  // tangent from below: Case 3 slivers, Case 4
-    case 3: h = tiny<T>(in, T(1)); break;                  // centre on the horizon, just off (Case 2/3)
-    case 4: h = ry * (T(2) * unit_random<T>(in) - T(1)); break;  // Cases 2-3 at any depth
-    default: h = T(2) * unit_random<T>(in) - T(1); break;        // any elevation
+    case 1:
+      h = ry * (T(1) + tiny<T>(in, T(1)));
+      break;  // tangent from above, just off (Case 1/2)
+    case 2:
+      h = -ry * (T(1) + tiny<T>(in, T(1)));
+      break;  // tangent from below: Case 3 slivers, Case 4
+    case 3:
+      h = tiny<T>(in, T(1));
+      break;  // centre on the horizon, just off (Case 2/3)
+    case 4:
+      h = ry * (T(2) * unit_random<T>(in) - T(1));
+      break;  // Cases 2-3 at any depth
+    default:
+      h = T(2) * unit_random<T>(in) - T(1);
+      break;  // any elevation
   }
   if (!std::isfinite(h)) return g;
   h = std::clamp(h, T(-1), T(1));
@@ -60,7 +70,8 @@ struct ProjectedCapReference {
 };
 template <class T> ProjectedCapReference projected_cap_reference(const SphereLightGeometry<T>& g) {
   ProjectedCapReference r;
-  const Vec3<L> nl = g.shading.normal.template cast<L>(), to_c = g.light.center.template cast<L>() - g.shading.position.template cast<L>();
+  const Vec3<L> nl = g.shading.normal.template cast<L>(),
+                to_c = g.light.center.template cast<L>() - g.shading.position.template cast<L>();
   const L d = to_c.norm(), rad = L(g.light.radius), nn = nl.norm();
   if (!(d > rad && rad > 0 && nn > 0 && std::isfinite(d) && std::isfinite(nn))) return r;
   r.defined = true;
@@ -71,9 +82,9 @@ template <class T> ProjectedCapReference projected_cap_reference(const SphereLig
 }
 
 template <class T, CutDiskInverse M>
-void check_projected_cap_kernel(FuzzedDataProvider& in, const SphereLightGeometry<T>& g, const ProjectedCapView<T>& view,
-                                const ProjectedCapReference& ref, const SphereReference& sref, bool finite_input,
-                                const Mutation& mutate) {
+void check_projected_cap_kernel(FuzzedDataProvider& in, const SphereLightGeometry<T>& g,
+                                const ProjectedCapView<T>& view, const ProjectedCapReference& ref,
+                                const SphereReference& sref, bool finite_input, const Mutation& mutate) {
   const bool quintic = M == CutDiskInverse::kQuintic;
   const char* name = quintic ? "projected_cap_quintic" : "projected_cap_exact";
   // Margins of a direction (> 0 inside): against the light's cap (the samples' and the support's boundary, for
@@ -141,7 +152,8 @@ void check_projected_cap_kernel(FuzzedDataProvider& in, const SphereLightGeometr
     const Vec3<L> wl = to_local_l(s.direction);
     L coordinate = 0;
     for (int c = view.which_case == 3 ? 1 : 0; c < (view.which_case == 3 ? 3 : 2); ++c)
-      coordinate = std::max(coordinate, 1 / std::max(std::sqrt(std::max(L(0), (1 - wl[c]) * (1 + wl[c]))), std::sqrt(e)));
+      coordinate =
+          std::max(coordinate, 1 / std::max(std::sqrt(std::max(L(0), (1 - wl[c]) * (1 + wl[c]))), std::sqrt(e)));
     const L radius = lift_tol(s.direction) + e * (1 + coordinate);
     check_pdf_consistency_probed<T>(
         s.pdf, s.direction, [&](const Vec3<T>& w) { return mutate.pdf(pdf_projected_spherical_cap<T, M>(view, w)); },
@@ -157,8 +169,9 @@ void check_projected_cap_kernel(FuzzedDataProvider& in, const SphereLightGeometr
     const Margins m = margins(w);
     const L tol = sref.tol + lift_tol(w);
     if (m.light < -tol || m.height < -e)
-      WARPCHECK_FUZZ_REQUIRE(p == T(0), "pdf > 0 outside the cap or below the horizon",
-                             geo << "pdf " << p << " margin " << m.light << " tol " << tol << " n.w " << m.height << "\n");
+      WARPCHECK_FUZZ_REQUIRE(
+          p == T(0), "pdf > 0 outside the cap or below the horizon",
+          geo << "pdf " << p << " margin " << m.light << " tol " << tol << " n.w " << m.height << "\n");
   }
 }
 
@@ -186,14 +199,17 @@ template <class T> void check_projected_cap(FuzzedDataProvider& in, const Mutati
   if (view.valid() && ref.defined && view.which_case <= 2) {
     const Quadrature q = reference_cap_projected_solid_angle(ref.t, ref.theta_max);
     const L th = ref.theta_max;
-    const L sens = std::tan(th) * std::sin(th) * ring_cosine_integral(th, ref.t) + kTwoPi<L> * 2 * std::pow(std::sin(th / 2), 2);
-    const L rel = q.value > 0 ? (L(kTolUlps) * eps<T>() * sref.kappa * sens + 16 * q.error) / q.value + 16 * eps<T>() : L(1);
-    const std::string geo = describe(g, Vec2<T>(Vec2<T>::Zero()), "projected_cap view") + "case " + std::to_string(view.which_case) + "\n";
+    const L sens =
+        std::tan(th) * std::sin(th) * ring_cosine_integral(th, ref.t) + kTwoPi<L> * 2 * std::pow(std::sin(th / 2), 2);
+    const L rel =
+        q.value > 0 ? (L(kTolUlps) * eps<T>() * sref.kappa * sens + 16 * q.error) / q.value + 16 * eps<T>() : L(1);
+    const std::string geo =
+        describe(g, Vec2<T>(Vec2<T>::Zero()), "projected_cap view") + "case " + std::to_string(view.which_case) + "\n";
     const L total = L(mutate.normaliser(view.total));
     if (rel < L(0.5))
       WARPCHECK_FUZZ_REQUIRE(std::abs(total / q.value - 1) <= rel, "A_E + A_D differs from the projected solid angle",
-                             geo << "A_E + A_D " << total << " reference " << q.value << " (quadrature error " << q.error
-                                 << ") ratio - 1 " << (total / q.value - 1) << " allowed " << rel << "\n");
+                             geo << "A_E + A_D " << total << " reference " << q.value << " (quadrature error "
+                                 << q.error << ") ratio - 1 " << (total / q.value - 1) << " allowed " << rel << "\n");
   }
   check_projected_cap_kernel<T, CutDiskInverse::kQuintic>(in, g, view, ref, sref, finite_input, mutate);
   check_projected_cap_kernel<T, CutDiskInverse::kExact>(in, g, view, ref, sref, finite_input, mutate);

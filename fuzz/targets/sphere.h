@@ -22,14 +22,14 @@ template <class T> void check_sphere(FuzzedDataProvider& in) {
       const DirectionSample<T> s = kernel == 0 ? sample_sphere_solid_angle(g, u) : sample_sphere_visible_area(g, u);
       const std::string geo = describe(g, u, name);
       check_sample_shape(s, geo);
-      if (!finite_input)
-        WARPCHECK_FUZZ_REQUIRE(!s.valid(), "a sample from non-finite input", geo);
+      if (!finite_input) WARPCHECK_FUZZ_REQUIRE(!s.valid(), "a sample from non-finite input", geo);
       if (!s.valid()) continue;
       WARPCHECK_FUZZ_REQUIRE(view.valid(), "a sample although the view is invalid", geo);
       L d, miss;
       const L margin = sphere_margin(g, s.direction, &d, &miss);
-      WARPCHECK_FUZZ_REQUIRE(margin >= -tol, "direction outside the sphere",
-                             geo << "direction " << show(s.direction) << " margin " << margin << " tol " << tol << "\n");
+      WARPCHECK_FUZZ_REQUIRE(
+          margin >= -tol, "direction outside the sphere",
+          geo << "direction " << show(s.direction) << " margin " << margin << " tol " << tol << "\n");
       if (kernel == 0) {
         // Same view, same formula: the constant density must agree to rounding.
         check_pdf_consistency<T>(s.pdf, pdf_sphere_solid_angle(g, s.direction), 4 * eps<T>(), margin, tol, geo);
@@ -52,15 +52,16 @@ template <class T> void check_sphere(FuzzedDataProvider& in) {
   const Vec3<T> w = safe_normalized(in.ConsumeBool() ? vec3<T>(in) : near(in, view.frame.z));
   const T p0 = pdf_sphere_solid_angle(g, w), p1 = pdf_sphere_visible_area(g, w);
   const std::string geo = describe(g, Vec2<T>(Vec2<T>::Zero()), "sphere pdf") + "w " + show(w) + "\n";
-  WARPCHECK_FUZZ_REQUIRE(std::isfinite(p0) && p0 >= T(0) && std::isfinite(p1) && p1 >= T(0),
-                         "pdf not finite and >= 0", geo << "pdfs " << p0 << " " << p1 << "\n");
+  WARPCHECK_FUZZ_REQUIRE(std::isfinite(p0) && p0 >= T(0) && std::isfinite(p1) && p1 >= T(0), "pdf not finite and >= 0",
+                         geo << "pdfs " << p0 << " " << p1 << "\n");
   if (!view.valid()) WARPCHECK_FUZZ_REQUIRE(p0 == T(0) && p1 == T(0), "pdf > 0 for invalid geometry", geo);
   const L wn = w.template cast<L>().norm();
   if (view.valid() && wn > 0 && std::isfinite(wn)) {
     L d, miss;
     const L margin = sphere_margin(g, w, &d, &miss);
-    if (margin < -tol) WARPCHECK_FUZZ_REQUIRE(p0 == T(0) && p1 == T(0), "pdf > 0 outside the sphere",
-                                              geo << "margin " << margin << " tol " << tol << " pdfs " << p0 << " " << p1 << "\n");
+    if (margin < -tol)
+      WARPCHECK_FUZZ_REQUIRE(p0 == T(0) && p1 == T(0), "pdf > 0 outside the sphere",
+                             geo << "margin " << margin << " tol " << tol << " pdfs " << p0 << " " << p1 << "\n");
   }
 }
 

@@ -12,9 +12,10 @@ template <class T> void check_spherical_rectangle(FuzzedDataProvider& in) {
   g.light = decode_polygon<T>(in, /*rectangle_bias=*/in.ConsumeIntegralInRange<int>(0, 7) != 0);
   g.shading = decode_polygon_shading<T>(in, g.light);
   const SphericalRectangleView<T> v = make_spherical_rectangle_view(g);
-  check_polygon_kernel<T>(in, g, "spherical_rectangle", false, PolygonDensity::kConstant,
-                          [&](const Vec2<T>& u) { return sample_spherical_rectangle(v, u); },
-                          [&](const Vec3<T>& w) { return pdf_spherical_rectangle(g, w); });
+  check_polygon_kernel<T>(
+      in, g, "spherical_rectangle", false, PolygonDensity::kConstant,
+      [&](const Vec2<T>& u) { return sample_spherical_rectangle(v, u); },
+      [&](const Vec3<T>& w) { return pdf_spherical_rectangle(g, w); });
 }
 
 }  // namespace warpcheck::fuzz

@@ -37,8 +37,8 @@
 //    base's n.g(w) from g's angular error over n.g(w); the normaliser: the uniform one is (1 - cos psi_img) / 2,
 //    moved by sin(psi_img) delta_img, the cosine one is the projected area P_img, moved by at most its boundary
 //    length 2 pi sin(psi_img) times delta_img (a finer bound: sptd_reference), plus the resolution of the kernel's
-//    disk coordinates (e per unit of abscissa, times the region's height); the quadrature's own error estimate. (The reference's own rounding has the same form with eps_L, which is at
-//    most eps_double / 2048.)
+//    disk coordinates (e per unit of abscissa, times the region's height); the quadrature's own error estimate. (The
+//    reference's own rounding has the same form with eps_L, which is at most eps_double / 2048.)
 #pragma once
 
 #include "common_cap.h"
@@ -56,7 +56,8 @@ template <class T> Vec3<T> unit_or_z(const Vec3<T>& v) {
 template <class T> Vec3<T> decode_pivot(FuzzedDataProvider& in) {
   const int digits = std::numeric_limits<T>::digits;
   switch (in.ConsumeIntegralInRange<int>(0, 3)) {
-    case 0: return vec3<T>(in);  // raw: often |r_p| >= 1 (no pivot)
+    case 0:
+      return vec3<T>(in);  // raw: often |r_p| >= 1 (no pivot)
     case 1: {
       const Vec3<T> dir = unit_or_z(vec3<T>(in));
       return dir * (T(1) - std::ldexp(T(1), -in.ConsumeIntegralInRange<int>(1, digits + 2)));
@@ -76,25 +77,43 @@ template <class T> Vec3<T> decode_pivot(FuzzedDataProvider& in) {
 template <class T> Cap<T> decode_sptd_cap(FuzzedDataProvider& in, const Vec3<T>& p) {
   Cap<T> c;
   switch (in.ConsumeIntegralInRange<int>(0, 4)) {
-    case 0: c.one_minus_cos = T(2); break;  // the whole sphere
-    case 1: c.one_minus_cos = std::ldexp(T(1), -in.ConsumeIntegralInRange<int>(1, std::numeric_limits<T>::digits + 40)); break;
-    case 2: c.one_minus_cos = T(2) - std::ldexp(T(2), -in.ConsumeIntegralInRange<int>(1, std::numeric_limits<T>::digits + 2)); break;
-    case 3: c.one_minus_cos = scalar<T>(in); break;  // negative, zero, > 2, NaN, ...
-    default: c.one_minus_cos = T(2) * unit_random<T>(in); break;
+    case 0:
+      c.one_minus_cos = T(2);
+      break;  // the whole sphere
+    case 1:
+      c.one_minus_cos = std::ldexp(T(1), -in.ConsumeIntegralInRange<int>(1, std::numeric_limits<T>::digits + 40));
+      break;
+    case 2:
+      c.one_minus_cos = T(2) - std::ldexp(T(2), -in.ConsumeIntegralInRange<int>(1, std::numeric_limits<T>::digits + 2));
+      break;
+    case 3:
+      c.one_minus_cos = scalar<T>(in);
+      break;  // negative, zero, > 2, NaN, ...
+    default:
+      c.one_minus_cos = T(2) * unit_random<T>(in);
+      break;
   }
   const Vec3<T> pu = unit_or_z(p);
   const T omc = std::clamp(c.one_minus_cos, T(0), T(2));
   const T psi = std::isfinite(omc) ? T(2) * std::asin(std::sqrt(omc / T(2))) : T(0);
   switch (in.ConsumeIntegralInRange<int>(0, 4)) {
-    case 0: c.axis = vec3<T>(in); break;  // raw (possibly zero or unnormalised)
-    case 1: c.axis = near(in, pu); break;  // around the pivot direction
+    case 0:
+      c.axis = vec3<T>(in);
+      break;  // raw (possibly zero or unnormalised)
+    case 1:
+      c.axis = near(in, pu);
+      break;   // around the pivot direction
     case 2: {  // the boundary through the pivot direction, just off
       const T a = psi + tiny<T>(in, T(1));
       c.axis = std::cos(a) * pu + std::sin(a) * perpendicular(in, pu);
       break;
     }
-    case 3: c.axis = near(in, Vec3<T>(-pu)); break;  // opposite
-    default: c.axis = unit_or_z(vec3<T>(in)); break;
+    case 3:
+      c.axis = near(in, Vec3<T>(-pu));
+      break;  // opposite
+    default:
+      c.axis = unit_or_z(vec3<T>(in));
+      break;
   }
   return c;
 }
@@ -188,7 +207,8 @@ SptdReference sptd_reference(const SptdCapGeometry<T>& geo, L delta_c, L rel_sin
     // images, as in Eq. 7, lose eps / psi_s relatively for tiny caps). That cap's axis is the in-plane direction
     // orthogonal to g(p+) - g(p-) on the side of g(p+) + g(p-); g(C) is that cap or its complement.
     const Vec3<L> t = in_plane(r.axis);
-    const Vec3<L> pp = std::cos(r.psi) * r.axis + std::sin(r.psi) * t, pm = std::cos(r.psi) * r.axis - std::sin(r.psi) * t;
+    const Vec3<L> pp = std::cos(r.psi) * r.axis + std::sin(r.psi) * t,
+                  pm = std::cos(r.psi) * r.axis - std::sin(r.psi) * t;
     const Vec3<L> gp = r.g(pp), gm = r.g(pm);
     const L sin_s = std::min(L(1), r.k * std::sin(r.psi) / ((pp - r.rp).norm() * (pm - r.rp).norm()));
     const Vec3<L> plane_normal = r.axis.cross(t), chord = gp - gm, sum = gp + gm;
@@ -219,8 +239,9 @@ SptdReference sptd_reference(const SptdCapGeometry<T>& geo, L delta_c, L rel_sin
       // 2.3e-13, psi_s = 2e-3 known to ~1e-9, and p's margin from the image circle, 1.5e-10, decided the orientation
       // wrongly). A margin smaller than its error says nothing.
       const L eps_l = std::numeric_limits<L>::epsilon();
-      const L psi_s_error = 16 * eps_l * (1 + std::tan(std::min(psi_s, L(1.5))) *
-                                                  (1 / (pp - r.rp).norm() + 1 / (pm - r.rp).norm() + 1 / (1 - r.r)));
+      const L psi_s_error =
+          16 * eps_l *
+          (1 + std::tan(std::min(psi_s, L(1.5))) * (1 / (pp - r.rp).norm() + 1 / (pm - r.rp).norm() + 1 / (1 - r.r)));
       struct Candidate {
         Vec3<L> world, image;
         L image_error;  // of the image point's direction
@@ -233,7 +254,8 @@ SptdReference sptd_reference(const SptdCapGeometry<T>& geo, L delta_c, L rel_sin
         const L rho = (w - r.rp).norm();
         return Candidate{w, r.g(w), 16 * eps_l * (1 + 1 / rho + r.k / (rho * rho))};
       };
-      const Candidate candidates[] = {{p, Vec3<L>(-p), 0}, {Vec3<L>(-p), p, 0}, computed(r.axis), computed(Vec3<L>(-r.axis))};
+      const Candidate candidates[] = {
+          {p, Vec3<L>(-p), 0}, {Vec3<L>(-p), p, 0}, computed(r.axis), computed(Vec3<L>(-r.axis))};
       auto margin = [&](const Candidate& c) {
         const L image = std::abs(angle_between(c.image, small_axis) - psi_s) - psi_s_error - c.image_error;
         const L world = std::abs(angle_between(c.world, r.axis) - r.psi) - 16 * eps_l;
@@ -258,10 +280,10 @@ SptdReference sptd_reference(const SptdCapGeometry<T>& geo, L delta_c, L rel_sin
   // image circle's points are known to that angle), and a relative one from the chord formula above, whose
   // inputs k, sin(psi) and |p+- - r_p| the kernel knows to eps / (1 - r), rel_sin_c (e for a decoded cap, whose
   // 1 - cos is exact; e kappa for the light's cone, d's relative rounding) and (e + delta_C) / dist relatively:
-  // sin(psi') to rho = e (2 + 1 / (1 - r)) + rel_sin_c + 2 (e + delta_C) / dist, psi' to |tan psi'| rho. The uniform normaliser
-  // (1 - cos psi') / 2 moves by sin(psi') dpsi'; the projected solid angle P by dP/dpsi' dpsi' =
-  // sin(psi') I(psi') dpsi' (common_cap.h) plus, for the axis's error delta_img, at most the cap's solid angle
-  // times it (2 pi (1 - cos psi') delta_img, as in projected_cap.h).
+  // sin(psi') to rho = e (2 + 1 / (1 - r)) + rel_sin_c + 2 (e + delta_C) / dist, psi' to |tan psi'| rho. The uniform
+  // normaliser (1 - cos psi') / 2 moves by sin(psi') dpsi'; the projected solid angle P by dP/dpsi' dpsi' = sin(psi')
+  // I(psi') dpsi' (common_cap.h) plus, for the axis's error delta_img, at most the cap's solid angle times it (2 pi (1
+  // - cos psi') delta_img, as in projected_cap.h).
   const L rho = e * (2 + 1 / (1 - r.r)) + rel_sin_c + 2 * (e + delta_c) / r.dist;
   const L dpsi = r.whole ? L(0) : std::min(r.delta_img, std::abs(std::tan(r.img_psi)) * rho);
   if (r.uniform) {
@@ -276,16 +298,17 @@ SptdReference sptd_reference(const SptdCapGeometry<T>& geo, L delta_c, L rel_sin
     // the unit disk of n): its abscissae (the ellipse's centre x_c, the cut x0) carry absolute errors of a few eps,
     // and R's area moves by at most its height 2 sin(psi') per unit of abscissa. Relative to a small R that is the
     // dominant term (e.g. an image cap of 7e-7 rad just across the horizon: its crescent is 4e-13 wide in x).
-    r.norm_rel = (std::sin(r.img_psi) * ring_cosine_integral(r.img_psi, t_img) * dpsi + kTwoPi<L> * r.img_omc * r.delta_img +
-                  2 * e * std::sin(r.img_psi) + 16 * q.error) / q.value + 16 * eps<T>();
+    r.norm_rel = (std::sin(r.img_psi) * ring_cosine_integral(r.img_psi, t_img) * dpsi +
+                  kTwoPi<L> * r.img_omc * r.delta_img + 2 * e * std::sin(r.img_psi) + 16 * q.error) /
+                     q.value +
+                 16 * eps<T>();
   }
   r.defined = std::isfinite(r.norm) && r.norm > 0;
   return r;
 }
 
-template <class T>
-void check_sptd_kernel(FuzzedDataProvider& in, const SptdCapGeometry<T>& geo, const SptdReference& ref, const char* name,
-                       const Mutation& mutate) {
+template <class T> void check_sptd_kernel(FuzzedDataProvider& in, const SptdCapGeometry<T>& geo,
+                                          const SptdReference& ref, const char* name, const Mutation& mutate) {
   const SptdCapView<T> view = make_sptd_cap_view(geo);
   const L e = L(kTolUlps) * eps<T>();
   const bool finite_input = all_finite(geo.sptd.pivot) && all_finite(geo.cap.axis) &&
@@ -320,12 +343,14 @@ void check_sptd_kernel(FuzzedDataProvider& in, const SptdCapGeometry<T>& geo, co
     WARPCHECK_FUZZ_REQUIRE(!ref.invalid, "a sample from input without a valid pivot, cap or axis", geometry);
     if (!ref.defined) continue;
     const At a = at(s.direction);
-    WARPCHECK_FUZZ_REQUIRE(a.margin >= -a.tol, "direction outside the cap",
-                           geometry << "direction " << show(s.direction) << " margin " << a.margin << " tol " << a.tol << "\n");
+    WARPCHECK_FUZZ_REQUIRE(
+        a.margin >= -a.tol, "direction outside the cap",
+        geometry << "direction " << show(s.direction) << " margin " << a.margin << " tol " << a.tol << "\n");
     if (ref.oriented && a.expected > 0 && a.rel < L(0.5))
-      WARPCHECK_FUZZ_REQUIRE(std::abs(L(s.pdf) / a.expected - 1) <= a.rel, "sample pdf differs from the reference density",
-                             geometry << "direction " << show(s.direction) << " pdf " << s.pdf << " reference " << a.expected
-                                      << " ratio - 1 " << (L(s.pdf) / a.expected - 1) << " allowed " << a.rel << "\n");
+      WARPCHECK_FUZZ_REQUIRE(
+          std::abs(L(s.pdf) / a.expected - 1) <= a.rel, "sample pdf differs from the reference density",
+          geometry << "direction " << show(s.direction) << " pdf " << s.pdf << " reference " << a.expected
+                   << " ratio - 1 " << (L(s.pdf) / a.expected - 1) << " allowed " << a.rel << "\n");
   }
   // pdf at an arbitrary unit direction (or one near the cap's axis): finite, >= 0, 0 for invalid input and outside,
   // and the reference density where both are positive.
@@ -333,18 +358,22 @@ void check_sptd_kernel(FuzzedDataProvider& in, const SptdCapGeometry<T>& geo, co
   const T p = mutate.pdf(pdf_sptd_cap(view, w));
   const std::string geometry = describe(geo, Vec2<T>(Vec2<T>::Zero()), name) + "pdf at w " + show(w) + "\n";
   WARPCHECK_FUZZ_REQUIRE(std::isfinite(p) && p >= T(0), "pdf not finite and >= 0", geometry << "pdf " << p << "\n");
-  if (ref.invalid || !view.valid()) WARPCHECK_FUZZ_REQUIRE(p == T(0), "pdf > 0 for invalid input", geometry << "pdf " << p << "\n");
+  if (ref.invalid || !view.valid())
+    WARPCHECK_FUZZ_REQUIRE(p == T(0), "pdf > 0 for invalid input", geometry << "pdf " << p << "\n");
   if (!ref.defined || !view.valid() || w.isZero()) return;
   const At a = at(w);
   if (a.margin < -a.tol)
-    WARPCHECK_FUZZ_REQUIRE(p == T(0), "pdf > 0 outside the cap", geometry << "pdf " << p << " margin " << a.margin << " tol " << a.tol << "\n");
+    WARPCHECK_FUZZ_REQUIRE(p == T(0), "pdf > 0 outside the cap",
+                           geometry << "pdf " << p << " margin " << a.margin << " tol " << a.tol << "\n");
   if (ref.oriented && p > T(0) && a.expected > 0 && a.rel < L(0.5))
-    WARPCHECK_FUZZ_REQUIRE(std::abs(L(p) / a.expected - 1) <= a.rel, "pdf(direction) differs from the reference density",
-                           geometry << "pdf " << p << " reference " << a.expected << " ratio - 1 " << (L(p) / a.expected - 1)
-                                    << " allowed " << a.rel << " margin " << a.margin << "\n");
+    WARPCHECK_FUZZ_REQUIRE(
+        std::abs(L(p) / a.expected - 1) <= a.rel, "pdf(direction) differs from the reference density",
+        geometry << "pdf " << p << " reference " << a.expected << " ratio - 1 " << (L(p) / a.expected - 1)
+                 << " allowed " << a.rel << " margin " << a.margin << "\n");
   if (ref.oriented && p == T(0) && a.expected > 0 && a.rel < L(0.5))
-    WARPCHECK_FUZZ_REQUIRE(a.margin <= a.tol, "pdf(direction) is 0 inside the cap where the reference density is not",
-                           geometry << "reference " << a.expected << " margin " << a.margin << " tol " << a.tol << "\n");
+    WARPCHECK_FUZZ_REQUIRE(
+        a.margin <= a.tol, "pdf(direction) is 0 inside the cap where the reference density is not",
+        geometry << "reference " << a.expected << " margin " << a.margin << " tol " << a.tol << "\n");
 }
 
 // One decoded input: the geometry the kernel gets, its reference, and the name of the way in.
@@ -363,17 +392,26 @@ template <class T> SptdCase<T> decode_sptd(FuzzedDataProvider& in) {
     geo.sptd.base = mode == 0 ? SptdBase::kUniform : SptdBase::kClampedCosine;
     geo.cap = decode_sptd_cap<T>(in, geo.sptd.pivot);
     switch (in.ConsumeIntegralInRange<int>(0, 3)) {
-      case 0: geo.sptd.base_axis = vec3<T>(in); break;
-      case 1: geo.sptd.base_axis = near(in, unit_or_z(geo.sptd.pivot)); break;
-      case 2: geo.sptd.base_axis = perpendicular(in, Vec3<T>(geo.cap.axis)); break;  // g(C) near the horizon
-      default: geo.sptd.base_axis = geo.cap.axis; break;
+      case 0:
+        geo.sptd.base_axis = vec3<T>(in);
+        break;
+      case 1:
+        geo.sptd.base_axis = near(in, unit_or_z(geo.sptd.pivot));
+        break;
+      case 2:
+        geo.sptd.base_axis = perpendicular(in, Vec3<T>(geo.cap.axis));
+        break;  // g(C) near the horizon
+      default:
+        geo.sptd.base_axis = geo.cap.axis;
+        break;
     }
     c.ref = sptd_reference(geo, L(kTolUlps) * eps<T>(), L(kTolUlps) * eps<T>());
     c.name = mode == 0 ? "sptd_uniform" : "sptd_cosine";
   } else if (mode == 2) {  // the pivot phase function over a cap (Sec. 6.2)
     const Vec3<T> wo = in.ConsumeBool() ? unit_or_z(vec3<T>(in)) : vec3<T>(in);
     T gp;
-    if (in.ConsumeBool()) gp = hg_to_pivot(T(2) * unit_random<T>(in) - T(1));  // Eqs. 27-28
+    if (in.ConsumeBool())
+      gp = hg_to_pivot(T(2) * unit_random<T>(in) - T(1));  // Eqs. 27-28
     else {
       const T sign = in.ConsumeBool() ? T(1) : T(-1);
       gp = sign * (T(1) - std::ldexp(T(1), -in.ConsumeIntegralInRange<int>(1, std::numeric_limits<T>::digits + 2)));
@@ -392,7 +430,8 @@ template <class T> SptdCase<T> decode_sptd(FuzzedDataProvider& in) {
     const SphereReference sref = sphere_reference(light);
     const Vec3<L> to_c = light.light.center.template cast<L>() - light.shading.position.template cast<L>();
     if (!(sref.d > sref.r && sref.r > 0 && std::isfinite(sref.d))) {
-      c.ref.invalid = !(all_finite(light.light.center) && all_finite(light.shading.position) && std::isfinite(light.light.radius)) ||
+      c.ref.invalid = !(all_finite(light.light.center) && all_finite(light.shading.position) &&
+                        std::isfinite(light.light.radius)) ||
                       sref.r <= 0 || sref.d < sref.r * (1 - 4 * eps<T>());
     } else {
       const L s2 = (sref.r / sref.d) * (sref.r / sref.d);

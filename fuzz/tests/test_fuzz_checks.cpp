@@ -47,7 +47,8 @@ double caught_share(const std::string& target, const Check& check, Mutation::Kin
   }
   EXPECT_GT(inputs.size(), 20u) << target << ": corpus too small to mean anything";
   const double share = inputs.empty() ? 0 : double(caught) / double(inputs.size());
-  std::printf("%s mutation %d: caught on %d of %zu inputs (%.3f)\n", target.c_str(), int(kind), caught, inputs.size(), share);
+  std::printf("%s mutation %d: caught on %d of %zu inputs (%.3f)\n", target.c_str(), int(kind), caught, inputs.size(),
+              share);
   return share;
 }
 
@@ -56,7 +57,8 @@ struct Family {
   Check check;
 };
 const Family kFamilies[] = {
-    {"fuzz_projected_cap_double", [](FuzzedDataProvider& in, const Mutation& m) { check_projected_cap<double>(in, m); }},
+    {"fuzz_projected_cap_double",
+     [](FuzzedDataProvider& in, const Mutation& m) { check_projected_cap<double>(in, m); }},
     {"fuzz_projected_cap_float", [](FuzzedDataProvider& in, const Mutation& m) { check_projected_cap<float>(in, m); }},
     {"fuzz_ltc_double", [](FuzzedDataProvider& in, const Mutation& m) { check_ltc<double>(in, m); }},
     {"fuzz_ltc_float", [](FuzzedDataProvider& in, const Mutation& m) { check_ltc<float>(in, m); }},
@@ -132,12 +134,20 @@ PolygonLightGeometry<double> margin_case_geometry(const MarginCase& c) {
 TEST(FuzzChecks, PolygonMarginsRelaxationsStillRejectDirectionsOutsideTheLightByAHundredTimesTheirCredit) {
   const MarginCase cases[] = {
       {"4a059601 (polygon_solid_angle_double)",
-       {{-5.8205884556628007e-11, 5.4736550784744359e-48, 0}, {0, -15.99951171875, -15.87695686519146},
-        {5.8205884556628007e-11, 5.4736550784744359e-48, -1}, {0, -4.9406564584124654e-324, -1}},
-       {5461.8461897465695, -3.9998779296875, -5400.9439573793379}, {-4, -4.9406564584124654e-324, 3}, true, 1e-12},
+       {{-5.8205884556628007e-11, 5.4736550784744359e-48, 0},
+        {0, -15.99951171875, -15.87695686519146},
+        {5.8205884556628007e-11, 5.4736550784744359e-48, -1},
+        {0, -4.9406564584124654e-324, -1}},
+       {5461.8461897465695, -3.9998779296875, -5400.9439573793379},
+       {-4, -4.9406564584124654e-324, 3},
+       true,
+       1e-12},
       {"e9b7708c (polygon_solid_angle_double)",
        {{3.96923828125, -1.4551915228366852e-11, 0}, {0, 0, -0.0}, {-4, 0, 0}, {2, -0.0, 3.96923828125}},
-       {0, 1, -3.057789944907e-33}, {0.93463450179615559, 0.13277316173762499, -0.32989337000680469}, true, 1e-9},
+       {0, 1, -3.057789944907e-33},
+       {0.93463450179615559, 0.13277316173762499, -0.32989337000680469},
+       true,
+       1e-9},
   };
   for (const MarginCase& c : cases) {
     const PolygonLightGeometry<double> g = margin_case_geometry(c);

@@ -40,7 +40,10 @@ template <class T> inline void sincos_quarter(T a, T& s, T& c) {
   // Horner from the highest term: p_k = 1/(2k+1)! - a^2 p_{k+1}, with 1/(2k+1)! = 1/(2k+3)! (2k+2)(2k+3).
   // The coefficients are computed as constants at compile time.
   constexpr auto coef = [] {
-    struct C { T s[n]; T c[n]; } r{};
+    struct C {
+      T s[n];
+      T c[n];
+    } r{};
     long double f = 1;  // k!
     for (int k = 0; k <= 2 * n; ++k) {
       if (k > 0) f *= k;
@@ -68,7 +71,7 @@ template <class T> inline void sincos_2pi(T u, T& s, T& c) {
   const T r = u - T(q) * T(0.25);
   T sa, ca;
   sincos_quarter(kTwoPi<T> * r, sa, ca);
-  const T w = T(q & 1);                                  // q = 1, 3: swap sine and cosine
+  const T w = T(q & 1);                                    // q = 1, 3: swap sine and cosine
   const T sin_sign = T(1) - T(2) * T((q >> 1) & 1);        // q = 2, 3: sine negative
   const T cos_sign = T(1) - T(2) * T(((q + 1) >> 1) & 1);  // q = 1, 2: cosine negative
   s = sin_sign * (w * ca + (T(1) - w) * sa);
@@ -89,9 +92,9 @@ template <class T> struct DirectionBatch {
 // primary samples (u0[i], u1[i]) in [0, 1]. Same formulas as the scalar kernel; the only differences are the
 // polynomial sincos above and the clamping of u to [0, 1] (the scalar kernel trusts its caller). Returns the
 // batch's reason: kNone (every output is a sample) or the view's reason (every output is zero).
-template <class T>
-NoSample sample_sphere_solid_angle_batch(const SphereView<T>& v, const T* __restrict u0, const T* __restrict u1,
-                                         std::size_t n, DirectionBatch<T> out) {
+template <class T> NoSample sample_sphere_solid_angle_batch(const SphereView<T>& v, const T* __restrict u0,
+                                                            const T* __restrict u1, std::size_t n,
+                                                            DirectionBatch<T> out) {
   T* __restrict ox = out.x;
   T* __restrict oy = out.y;
   T* __restrict oz = out.z;
@@ -156,9 +159,9 @@ NoSample sample_sphere_solid_angle_batch(const SphereView<T>& v, const T* __rest
 // Any kernel with a per-light view and a scalar sample(view, u) function, batched by a plain loop (no
 // vectorisation promised: the polygon and projected-cap kernels branch per sample). Gives the same batch
 // interface to every kernel; a sample declined individually gets pdf 0 and direction 0 in the output.
-template <class T, class View, class SampleFn>
-void sample_batch_scalar(const View& v, SampleFn&& sample, const T* u0, const T* u1, std::size_t n,
-                         DirectionBatch<T> out) {
+template <class T, class View, class SampleFn> void sample_batch_scalar(const View& v, SampleFn&& sample, const T* u0,
+                                                                        const T* u1, std::size_t n,
+                                                                        DirectionBatch<T> out) {
   for (std::size_t i = 0; i < n; ++i) {
     const DirectionSample<T> s = sample(v, Vec2<T>(u0[i], u1[i]));
     out.x[i] = s.direction.x();

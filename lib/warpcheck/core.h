@@ -37,17 +37,28 @@ enum class NoSample : std::uint8_t {
 
 constexpr const char* to_string(NoSample r) {
   switch (r) {
-    case NoSample::kNone: return "sample";
-    case NoSample::kNonFinite: return "non-finite input";
-    case NoSample::kBadNormal: return "zero or non-finite shading normal";
-    case NoSample::kZeroSize: return "light of zero size";
-    case NoSample::kNegativeSize: return "light of negative size";
-    case NoSample::kInsideLight: return "shading point inside or on the light";
-    case NoSample::kBelowHorizon: return "light entirely below the horizon";
-    case NoSample::kEdgeOn: return "light seen edge-on";
-    case NoSample::kTooSmall: return "light subtends no representable solid angle";
-    case NoSample::kOnSilhouette: return "sample on the silhouette (infinite density)";
-    case NoSample::kInvalidGeometry: return "invalid geometry";
+    case NoSample::kNone:
+      return "sample";
+    case NoSample::kNonFinite:
+      return "non-finite input";
+    case NoSample::kBadNormal:
+      return "zero or non-finite shading normal";
+    case NoSample::kZeroSize:
+      return "light of zero size";
+    case NoSample::kNegativeSize:
+      return "light of negative size";
+    case NoSample::kInsideLight:
+      return "shading point inside or on the light";
+    case NoSample::kBelowHorizon:
+      return "light entirely below the horizon";
+    case NoSample::kEdgeOn:
+      return "light seen edge-on";
+    case NoSample::kTooSmall:
+      return "light subtends no representable solid angle";
+    case NoSample::kOnSilhouette:
+      return "sample on the silhouette (infinite density)";
+    case NoSample::kInvalidGeometry:
+      return "invalid geometry";
   }
   return "unknown";
 }

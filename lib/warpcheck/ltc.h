@@ -24,9 +24,7 @@ template <class T> struct LtcPolygonGeometry {
   PolygonLightGeometry<T> polygon;
   Mat3<T> m = Mat3<T>::Identity();  // the LTC's transform, in the shading frame
 
-  template <class U> LtcPolygonGeometry<U> cast() const {
-    return {polygon.template cast<U>(), m.template cast<U>()};
-  }
+  template <class U> LtcPolygonGeometry<U> cast() const { return {polygon.template cast<U>(), m.template cast<U>()}; }
 };
 
 // M^-1 and |M| for |M| > 0, from Gaussian elimination with full pivoting (Eigen's FullPivLU): false for a singular
@@ -68,7 +66,7 @@ template <class T> struct LtcPolygonView {
   // rad inside; issue 7). The world edges V_{j+1} - V_j are exact.
   std::array<Vec3<T>, kMaxPolygonVertices> inward{};
   int planes = 0;
-  T integral = 0;                       // int_P p_M = A_Sigma(M^-1 P) / pi (Eq. 10)
+  T integral = 0;  // int_P p_M = A_Sigma(M^-1 P) / pi (Eq. 10)
 
   bool valid() const { return reason == NoSample::kNone; }
   // p_M at a world direction (not normalised over P).
@@ -109,8 +107,7 @@ template <class T> LtcPolygonView<T> make_ltc_polygon_view(const LtcPolygonGeome
   // |M| > 0 (Sec. 4.1). A singular or reflecting M has no LTC; an M whose inverse overflows neither.
   if (!ltc_inverse(g.m, &v.m_inv, &v.det)) return v.reason = NoSample::kInvalidGeometry, v;
   v.det_inv = T(1) / v.det;
-  v.transformed =
-      make_polygon_projected_view(ltc_transformed_polygon(pv, v.m_inv), ltc_vertex_rounding(g.m, v.m_inv));
+  v.transformed = make_polygon_projected_view(ltc_transformed_polygon(pv, v.m_inv), ltc_vertex_rounding(g.m, v.m_inv));
   if (!v.transformed.valid()) return v.reason = v.transformed.reason, v;
   v.integral = v.transformed.projected_solid_angle / kPi<T>;
   return v;
@@ -144,8 +141,8 @@ template <class T> T pdf_ltc_polygon(const LtcPolygonView<T>& v, const Vec3<T>& 
 // measured pdf-consistency 1.3e-4 (near xi_0 = 1) with 2 iterations and 5.7e-8 with 4. Correct first: 4.
 inline constexpr int kLtcSectorIterations = 4;
 
-template <class T>
-DirectionSample<T> sample_ltc_polygon(const LtcPolygonView<T>& v, const Vec2<T>& u, int iterations = kLtcSectorIterations) {
+template <class T> DirectionSample<T> sample_ltc_polygon(const LtcPolygonView<T>& v, const Vec2<T>& u,
+                                                         int iterations = kLtcSectorIterations) {
   if (!v.valid()) return DirectionSample<T>::none(v.reason);
   const DirectionSample<T> c = sample_polygon_projected_solid_angle(v.transformed, u, iterations);
   if (!c.valid()) return c;

@@ -24,7 +24,7 @@ enum class MisHeuristic : std::uint8_t { kBalance, kWeightedBalance, kClampedOpt
 
 template <class T> struct MixedPolygonShading {
   PolygonLightGeometry<T> polygon;
-  Mat3<T> m_specular = Mat3<T>::Identity();  // M_1
+  Mat3<T> m_specular = Mat3<T>::Identity();         // M_1
   T albedo_diffuse = T(1), albedo_specular = T(0);  // a_0, a_1
   T emitted = T(1);                                 // L_e
 };
@@ -57,8 +57,7 @@ template <class T> T idealized_integrand(const MixedPolygonShading<T>& s, const 
   const LtcPolygonView<T>& any = v.technique[0].valid() ? v.technique[0] : v.technique[1];
   const Vec3<T> l = any.frame.to_local(w) / w.norm();
   const T d0 = ltc_density_local<T>(Mat3<T>::Identity(), T(1), l);
-  const T d1 = v.technique[1].valid() ? ltc_density_local(v.technique[1].m_inv, v.technique[1].det_inv, l)
-                                      : T(0);
+  const T d1 = v.technique[1].valid() ? ltc_density_local(v.technique[1].m_inv, v.technique[1].det_inv, l) : T(0);
   return s.emitted * (s.albedo_diffuse * d0 + s.albedo_specular * d1);
 }
 
@@ -69,9 +68,12 @@ template <class T> T mis_weight(MisHeuristic h, int j, const std::array<T, 2>& p
   const T sum_cp = c[0] * p[0] + c[1] * p[1];
   const T weighted = sum_cp > T(0) ? c[j] * p[j] / sum_cp : balance;
   switch (h) {
-    case MisHeuristic::kBalance: return balance;
-    case MisHeuristic::kWeightedBalance: return weighted;
-    case MisHeuristic::kClampedOptimal: return v * weighted + (T(1) - v) * balance;
+    case MisHeuristic::kBalance:
+      return balance;
+    case MisHeuristic::kWeightedBalance:
+      return weighted;
+    case MisHeuristic::kClampedOptimal:
+      return v * weighted + (T(1) - v) * balance;
   }
   return T(0);
 }

@@ -10,9 +10,9 @@
 //   spherical_rectangle.h  Urena et al. 2013 (rectangles only)
 //
 // Conventions. A polygon has 3 to 8 vertices in world space, in either winding, and must be planar and
-// convex up to its coordinates' rounding, planar to 8 sqrt(eps) of its width (plus that rounding), and wider than the planarity tolerance.
-// check_polygon() is the validating constructor's test: it returns kInvalidGeometry or kZeroSize (and a message)
-// for anything else. Every kernel calls it, so no kernel ever samples invalid input.
+// convex up to its coordinates' rounding, planar to 8 sqrt(eps) of its width (plus that rounding), and wider than the
+// planarity tolerance. check_polygon() is the validating constructor's test: it returns kInvalidGeometry or kZeroSize
+// (and a message) for anything else. Every kernel calls it, so no kernel ever samples invalid input.
 #pragma once
 
 #include <algorithm>
@@ -28,8 +28,8 @@ namespace warpcheck {
 inline constexpr int kMaxPolygonVertices = 8;
 // Clipping a convex polygon to a half-space adds at most one vertex.
 inline constexpr int kMaxClippedVertices = kMaxPolygonVertices + 1;
-// The solid-angle fan adds the midpoint of a horizon edge wider than 90 degrees and of every edge wider than 120 degrees
-// (polygon_solid_angle.h): a convex spherical polygon's perimeter is at most 2 pi, so at most three in all.
+// The solid-angle fan adds the midpoint of a horizon edge wider than 90 degrees and of every edge wider than 120
+// degrees (polygon_solid_angle.h): a convex spherical polygon's perimeter is at most 2 pi, so at most three in all.
 inline constexpr int kMaxFanVertices = kMaxClippedVertices + 3;
 
 template <class T> struct PolygonLight {
@@ -80,9 +80,7 @@ template <class T> Vec3<T> kahan_cross(const Vec3<T>& a, const Vec3<T>& b) {
 }
 
 // z component of a x b for 2D vectors, by Kahan.
-template <class T> T kahan_cross2(const Vec2<T>& a, const Vec2<T>& b) {
-  return kahan_det(a.x(), a.y(), b.x(), b.y());
-}
+template <class T> T kahan_cross2(const Vec2<T>& a, const Vec2<T>& b) { return kahan_det(a.x(), a.y(), b.x(), b.y()); }
 
 // Normalises without overflow or underflow (scales by the largest entry first); zero stays zero.
 template <class T> Vec3<T> safe_normalized(const Vec3<T>& v) {
@@ -138,9 +136,8 @@ template <class T> bool edge_in_plane(const Vec3<T>& e, T err, const Vec3<T>& nh
 // kNone for a valid light; otherwise kNonFinite, kZeroSize or kInvalidGeometry, with a message if asked.
 // vertex_rounding: each vertex V_k is known to vertex_rounding |V_k|_inf (a caller that computed the vertices,
 // such as ltc.h's M^-1 P, passes its own bound).
-template <class T>
-NoSample check_polygon(const PolygonLight<T>& p, std::string* message = nullptr,
-                       T vertex_rounding = kPolygonVertexRounding<T>) {
+template <class T> NoSample check_polygon(const PolygonLight<T>& p, std::string* message = nullptr,
+                                          T vertex_rounding = kPolygonVertexRounding<T>) {
   auto fail = [&](NoSample r, const char* why) {
     if (message) *message = why;
     return r;
@@ -176,7 +173,8 @@ NoSample check_polygon(const PolygonLight<T>& p, std::string* message = nullptr,
   // noise, and kernels and references disagree about which side of it a direction lies on (found by
   // fuzz_polygon_solid_angle_double, 6815131d...: eight vertices within 1e-16 of a line, pdf > 0 half a radian
   // outside; issue 4; the float slivers of fuzz/README.md's known limits).
-  if (!(width > tol)) return fail(NoSample::kZeroSize, "narrower than its planarity tolerance (zero area up to rounding)");
+  if (!(width > tol))
+    return fail(NoSample::kZeroSize, "narrower than its planarity tolerance (zero area up to rounding)");
   for (int i = 0; i < p.count; ++i)
     if (std::abs(nhat.dot(p.vertices[i] - p.vertices[0])) > tol)
       return fail(NoSample::kInvalidGeometry, "vertices are not coplanar");
@@ -290,11 +288,11 @@ template <class T> LocalPolygon<T> clip_to_upper_hemisphere(const LocalPolygon<T
 
 template <class T> struct PolygonView {
   NoSample reason = NoSample::kNone;
-  Vec3<T> normal = Vec3<T>::Zero();  // unit shading normal
+  Vec3<T> normal = Vec3<T>::Zero();                              // unit shading normal
   Frame<T> frame = Frame<T>::from_z(Vec3<T>(T(0), T(0), T(1)));  // z: the shading normal
-  Vec3<T> plane_normal = Vec3<T>::Zero();  // unit right-hand normal of the vertex order
-  T plane_distance = 0;    // plane_normal . (V_0 - x): > 0 when the vertex order winds positively seen from x
-  LocalPolygon<T> local;   // V_k - x in the shading frame (flattened, see lift), not clipped
+  Vec3<T> plane_normal = Vec3<T>::Zero();                        // unit right-hand normal of the vertex order
+  T plane_distance = 0;   // plane_normal . (V_0 - x): > 0 when the vertex order winds positively seen from x
+  LocalPolygon<T> local;  // V_k - x in the shading frame (flattened, see lift), not clipped
   // lift[k] = plane_normal . (V_k - x) - plane_distance: how far vertex k is off the light's plane. Where the light
   // is non-planar beyond the offsets' rounding, `local` holds the vertices moved onto the plane, V_k - x - lift[k]
   // plane_normal, and polygon_inward_planes the flattened light's planes (flattened = true; make_polygon_view).
@@ -340,8 +338,8 @@ PolygonView<T> make_polygon_view(const PolygonLightGeometry<T>& g, T vertex_roun
   // fuzz_polygon_projected_double fe6b6d80... and fuzz_polygon_solid_angle_double 5c7b9846..., issue 7.)
   for (int i = 0; i < g.light.count; ++i) {
     const T side = v.plane_normal.dot(Vec3<T>(g.light.vertices[i] - g.shading.position));
-    const T err = vertex_rounding * g.light.vertices[i].cwiseAbs().maxCoeff() +
-                  T(8) * std::numeric_limits<T>::epsilon() * reach;
+    const T err =
+        vertex_rounding * g.light.vertices[i].cwiseAbs().maxCoeff() + T(8) * std::numeric_limits<T>::epsilon() * reach;
     if ((v.plane_distance > T(0) ? -side : side) > err) return v.reason = NoSample::kEdgeOn, v;
   }
   // check_polygon accepts a light off its plane by up to its planarity tolerance (input rounding of its coordinates,
@@ -410,8 +408,10 @@ template <class T> int polygon_inward_planes(const PolygonLightGeometry<T>& g, c
     out[j] = orient * kahan_cross(Vec3<T>(g.light.vertices[j] - g.shading.position - pv.lift[j] * nh), e);
   }
   for (int j = 0, prev = last; j < n && last >= 0; ++j) {
-    if (has_direction[j]) prev = j;
-    else out[j] = out[prev];
+    if (has_direction[j])
+      prev = j;
+    else
+      out[j] = out[prev];
   }
   return n;
 }

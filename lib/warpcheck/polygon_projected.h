@@ -49,16 +49,17 @@ template <class T> T atan2_approx(T y, T x) {
   const T hi = std::max(ax, ay), lo = std::min(ax, ay);
   if (!(hi > T(0))) return T(0);
   const T t = lo / hi, t2 = t * t;
-  T r = t * (T(0.9998660L) +
-             t2 * (T(-0.3302995L) + t2 * (T(0.1801410L) + t2 * (T(-0.0851330L) + t2 * T(0.0208351L)))));
+  T r = t * (T(0.9998660L) + t2 * (T(-0.3302995L) + t2 * (T(0.1801410L) + t2 * (T(-0.0851330L) + t2 * T(0.0208351L)))));
   if (ay > ax) r = kPi<T> / 2 - r;
   if (x < T(0)) r = kPi<T> - r;
   return std::signbit(y) ? -r : r;
 }
 
 template <class T, bool kBiased> T polygon_atan2(T y, T x) {
-  if constexpr (kBiased) return atan2_approx(y, x);
-  else return std::atan2(y, x);
+  if constexpr (kBiased)
+    return atan2_approx(y, x);
+  else
+    return std::atan2(y, x);
 }
 
 // ---- Ellipses in homogeneous form ------------------------------------------------------------------------
@@ -97,8 +98,8 @@ template <class T> struct EdgeEllipse {
 // an azimuth error of eps moves Eq. 3's point along the needle by eps / |n_z|, past the edge's end (found by
 // fuzz_polygon_projected_double: the light's plane containing the normal, samples 0.23 rad outside; our
 // remedy, issue 7). Without endpoints (a = b = 0), Eq. 3.
-template <class T> void edge_boundary_point(const EdgeEllipse<T>& e, const Vec3<T>& a, const Vec3<T>& b,
-                                            const Vec2<T>& w, T* r2, T* z2) {
+template <class T>
+void edge_boundary_point(const EdgeEllipse<T>& e, const Vec3<T>& a, const Vec3<T>& b, const Vec2<T>& w, T* r2, T* z2) {
   const T ca = kahan_cross2(w, Vec2<T>(a.x(), a.y())), cb = kahan_cross2(w, Vec2<T>(b.x(), b.y()));
   const T den = ca - cb;
   if (a != b && std::isfinite(den)) {
@@ -147,8 +148,8 @@ T ellipse_sector_area(const EdgeEllipse<T>& e, const Vec2<T>& s0, const Vec2<T>&
 // ---- Sectors ------------------------------------------------------------------------------------------------
 
 template <class T> struct ProjectedSector {
-  Vec2<T> s0 = Vec2<T>::Zero(), s1 = Vec2<T>::Zero();  // boundaries, counterclockwise, at most 180 degrees
-  EdgeEllipse<T> outer, inner;                          // inner only in the decentral case
+  Vec2<T> s0 = Vec2<T>::Zero(), s1 = Vec2<T>::Zero();            // boundaries, counterclockwise, at most 180 degrees
+  EdgeEllipse<T> outer, inner;                                   // inner only in the decentral case
   Vec3<T> outer_a = Vec3<T>::Zero(), outer_b = Vec3<T>::Zero();  // the edges' clipped endpoints (local frame)
   Vec3<T> inner_a = Vec3<T>::Zero(), inner_b = Vec3<T>::Zero();
   bool decentral = false;
@@ -249,8 +250,7 @@ template <class T, bool kBiased = false> T decentral_residual(const ProjectedSec
 //   Q = lambda_{o,k} D_o R s_k r_i^T - (lambda_{i,k} D_i R s_k + 2 A_q r_i) r_o^T.
 // Q is bilinear in (r_i, r_o), so we may scale r_l by any positive factor; we drop 1 / n_{l,z} so that r_l
 // stays finite as n_{i,z} -> 0. For quad k = 1 the area is measured from s_1, i.e. it is negative.
-template <class T, bool kBiased = false>
-Vec2<T> decentral_initialization(const ProjectedSector<T>& s, T target) {
+template <class T, bool kBiased = false> Vec2<T> decentral_initialization(const ProjectedSector<T>& s, T target) {
   const Vec2<T> s0 = s.s0 / s.s0.norm(), s1 = s.s1 / s.s1.norm();
   const Vec2<T> sh = s0 + s1;  // Eq. 8
   auto lambda = [](const EdgeEllipse<T>& e, const Vec2<T>& v) {
@@ -279,8 +279,8 @@ Vec2<T> decentral_initialization(const ProjectedSector<T>& s, T target) {
   const Vec2<T> ro = s.outer.times(Vec2<T>(mu(s.outer, sh) * sh + mu(s.outer, sk) * sk));
   const T di = lih * ri.dot(sh), do_ = loh * ro.dot(sh);
   // w^T Q w with w = s_k + tau R s_k (increasing_root_around): w . R s_k = tau |s_k|^2, r_l . w = r_l . s_k +
-  // tau r_l . R s_k, so P(tau) = lambda_{o,k} D_o tau |s_k|^2 (r_i . w) - (lambda_{i,k} D_i tau |s_k|^2 + 2 A_q r_i . w)
-  // (r_o . w).
+  // tau r_l . R s_k, so P(tau) = lambda_{o,k} D_o tau |s_k|^2 (r_i . w) - (lambda_{i,k} D_i tau |s_k|^2 + 2 A_q r_i .
+  // w) (r_o . w).
   const Vec2<T> rsk(-sk.y(), sk.x());  // R s_k
   const T ri_s = ri.dot(sk), ri_p = ri.dot(rsk), ro_s = ro.dot(sk), ro_p = ro.dot(rsk), s2 = sk.squaredNorm();
   const T a0 = -T(2) * aq * ri_s * ro_s;
@@ -362,8 +362,8 @@ template <class T> Vec2<T> invert_central_sector(const ProjectedSector<T>& s, T 
 template <class T> struct PolygonProjectedView {
   NoSample reason = NoSample::kNone;
   Frame<T> frame = Frame<T>::from_z(Vec3<T>(T(0), T(0), T(1)));
-  bool flip_y = false;           // y flipped so that the vertex order winds positively (Sec. 3.1)
-  LocalPolygon<T> clipped;       // in the (flipped) shading frame, clipped to z >= 0
+  bool flip_y = false;      // y flipped so that the vertex order winds positively (Sec. 3.1)
+  LocalPolygon<T> clipped;  // in the (flipped) shading frame, clipped to z >= 0
   std::array<Vec3<T>, kMaxClippedVertices> edge_normals{};  // n_j = v_j x v_{j+1} (Kahan), not normalised
   // The density's cone test (world space): the light's own edge planes (V_j - x) x (V_{j+1} - V_j), oriented
   // inwards, and the horizon. Not the n_j: those come from rounded V - x, and for an edge shorter than that
@@ -375,7 +375,7 @@ template <class T> struct PolygonProjectedView {
   bool central = true;
   int sector_count = 0;
   std::array<ProjectedSector<T>, kMaxClippedVertices> sectors{};
-  T projected_solid_angle = 0;   // A_Sigma, the sum of the sector areas
+  T projected_solid_angle = 0;  // A_Sigma, the sum of the sector areas
 
   bool valid() const { return reason == NoSample::kNone; }
   Vec3<T> to_local(const Vec3<T>& w) const {
@@ -483,7 +483,8 @@ PolygonProjectedView<T> make_polygon_projected_view(const PolygonLightGeometry<T
   // chain (found by fuzz_ltc_double 403f9cc0...: M = I, an edge 4e-15 long with n_z = -1e-17, A_Sigma 4.9e-32
   // instead of 0.708; issue 7).
   bool zenith_vertex = false;
-  for (int i = 0; i < m; ++i) zenith_vertex = zenith_vertex || (v.clipped.v[i].x() == T(0) && v.clipped.v[i].y() == T(0));
+  for (int i = 0; i < m; ++i)
+    zenith_vertex = zenith_vertex || (v.clipped.v[i].x() == T(0) && v.clipped.v[i].y() == T(0));
   v.central = !any_negative || zenith_vertex || winds_around_zenith(v.clipped);
   if (v.central) {
     // Sec. 3.1, Fig. 3a: one sector per edge. Its sine s0 x s1 is n_{j,z} >= 0 by construction.
@@ -531,9 +532,12 @@ PolygonProjectedView<T> make_polygon_projected_view(const PolygonLightGeometry<T
       s.outer_a = v.clipped.v[oe[a]], s.outer_b = v.clipped.v[(oe[a] + 1) % m];
       s.inner_a = v.clipped.v[ie[bi]], s.inner_b = v.clipped.v[(ie[bi] + 1) % m];
       s.s0 = cur;
-      if (order > T(0)) s.s1 = next_o, ++a;
-      else if (order < T(0)) s.s1 = next_i, ++bi;
-      else s.s1 = next_o, ++a, ++bi;
+      if (order > T(0))
+        s.s1 = next_o, ++a;
+      else if (order < T(0))
+        s.s1 = next_i, ++bi;
+      else
+        s.s1 = next_o, ++a, ++bi;
       cur = s.s1;
       const T cross = kahan_cross2(s.s0, s.s1);
       const T sine = cross > T(0) ? cross : T(0);  // a sector is at most 180 degrees: clamp rounding
@@ -617,9 +621,8 @@ DirectionSample<T> sample_polygon_projected_solid_angle(const PolygonProjectedVi
   return out;
 }
 
-template <class T>
-DirectionSample<T> sample_polygon_projected_solid_angle(const PolygonLightGeometry<T>& g, const Vec2<T>& u,
-                                                        int iterations = 2) {
+template <class T> DirectionSample<T> sample_polygon_projected_solid_angle(const PolygonLightGeometry<T>& g,
+                                                                           const Vec2<T>& u, int iterations = 2) {
   return sample_polygon_projected_solid_angle<T, false>(make_polygon_projected_view<T, false>(g), u, iterations);
 }
 template <class T> T pdf_polygon_projected_solid_angle(const PolygonLightGeometry<T>& g, const Vec3<T>& w) {
@@ -629,8 +632,8 @@ template <class T> T pdf_polygon_projected_solid_angle(const PolygonLightGeometr
 // Section 6.4, the biased variant: no iteration and the approximate atan2 everywhere the areas need one.
 // Its pdf is the one a renderer would use, cos / A_Sigma with the approximate A_Sigma; the true density of
 // its samples differs from it by the initialisation's error (that is the bias).
-template <class T> DirectionSample<T> sample_polygon_projected_solid_angle_biased(const PolygonLightGeometry<T>& g,
-                                                                                 const Vec2<T>& u) {
+template <class T>
+DirectionSample<T> sample_polygon_projected_solid_angle_biased(const PolygonLightGeometry<T>& g, const Vec2<T>& u) {
   return sample_polygon_projected_solid_angle<T, true>(make_polygon_projected_view<T, true>(g), u, 0);
 }
 template <class T> T pdf_polygon_projected_solid_angle_biased(const PolygonLightGeometry<T>& g, const Vec3<T>& w) {

@@ -19,10 +19,10 @@ namespace warpcheck {
 template <class T> struct PolygonFanView {
   NoSample reason = NoSample::kNone;
   int count = 0;
-  std::array<Vec3<T>, kMaxFanVertices> p{};           // vertex - shading point
-  std::array<Vec3<T>, kMaxFanVertices> e{};           // p_k - p_0, from the light's own vertices if unclipped
-  std::array<Vec3<T>, kMaxFanVertices> u{};           // p_k / |p_k|
-  std::array<T, kMaxFanVertices> len{};               // |p_k| by stableNorm (norm() underflows for |p| < 1e-154)
+  std::array<Vec3<T>, kMaxFanVertices> p{};  // vertex - shading point
+  std::array<Vec3<T>, kMaxFanVertices> e{};  // p_k - p_0, from the light's own vertices if unclipped
+  std::array<Vec3<T>, kMaxFanVertices> u{};  // p_k / |p_k|
+  std::array<T, kMaxFanVertices> len{};      // |p_k| by stableNorm (norm() underflows for |p| < 1e-154)
   // The cone is {w : inward_j . w >= 0, j < planes}: unclipped, inward_j = p_j x p_{j+1}; clipped, the
   // light's own edge planes (from V_j - x) and the horizon, never planes through two clip points, whose
   // normal is undetermined when the clip points (nearly) coincide (found by fuzz_polygon_solid_angle_double:
@@ -33,8 +33,8 @@ template <class T> struct PolygonFanView {
   // antipode of a vertex's direction, issue 7).
   std::array<Vec3<T>, kMaxFanVertices> inward{};
   int planes = 0;
-  Vec3<T> plane_normal = Vec3<T>::Zero();             // unit
-  T plane_distance = 0;                               // |plane_normal . p_0| > 0
+  Vec3<T> plane_normal = Vec3<T>::Zero();  // unit
+  T plane_distance = 0;                    // |plane_normal . p_0| > 0
   bool valid() const { return reason == NoSample::kNone; }
 };
 
@@ -51,8 +51,8 @@ template <class T> Vec3<T> unit_difference(const Vec3<T>& pa, T na, const Vec3<T
 
 // split_wide_edges (Section 5's sampler, make_polygon_solid_angle_view): every edge of the fan wider than 120 degrees
 // gets its midpoint as an extra vertex, and the fan is rooted at the first (see the end of this function).
-template <class T> PolygonFanView<T> make_polygon_fan_view(const PolygonLightGeometry<T>& g, bool clipped,
-                                                          bool split_wide_edges = false) {
+template <class T>
+PolygonFanView<T> make_polygon_fan_view(const PolygonLightGeometry<T>& g, bool clipped, bool split_wide_edges = false) {
   PolygonFanView<T> f;
   const PolygonView<T> pv = make_polygon_view(g);
   if (!pv.valid()) return f.reason = pv.reason, f;
@@ -217,8 +217,8 @@ template <class T> struct PolygonSolidAngleView {
 // p0 . (e1 x e2) / (|p0| |p1| |p2|) from the light's edges: a determinant of three nearly parallel unit vectors
 // cancels catastrophically for small, distant lights. (Peters uses a Householder reflection, Supplement C,
 // which is not available to us; this is our own remedy.)
-template <class T> PolygonSolidAngleView<T> make_polygon_solid_angle_view(const PolygonLightGeometry<T>& g,
-                                                                          bool clipped = false) {
+template <class T>
+PolygonSolidAngleView<T> make_polygon_solid_angle_view(const PolygonLightGeometry<T>& g, bool clipped = false) {
   PolygonSolidAngleView<T> v;
   v.fan = make_polygon_fan_view(g, clipped, /*split_wide_edges=*/true);
   if (!v.fan.valid()) return v.reason = v.fan.reason, v;
@@ -251,8 +251,8 @@ template <class T> PolygonSolidAngleView<T> make_polygon_solid_angle_view(const 
 }
 
 // Picks the fan triangle for xi_0 in proportion to `area`, returning the remaining area in it.
-template <class T, std::size_t N> int pick_fan_triangle(const std::array<T, N>& area, int count, T target,
-                                         T* remaining) {
+template <class T, std::size_t N>
+int pick_fan_triangle(const std::array<T, N>& area, int count, T target, T* remaining) {
   int k = -1;
   for (int i = 1; i + 1 < count; ++i) {
     if (!(area[i] > T(0))) continue;
@@ -273,12 +273,12 @@ template <class T, std::size_t N> int pick_fan_triangle(const std::array<T, N>& 
 // The point is measured from the nearer end (tangents t_b towards c, t_c towards b): cos(phi) b + sin(phi) t_b
 // or cos(psi) c + sin(psi) t_c. A tangent is the component of the other end orthogonal to this one, made
 // orthogonal once more after the subtraction: for nearly antipodal ends that component is as small as the ends'
-// distance from antipodal and carries their rounding. Written from b alone, as b (1 - xi h) + sqrt(xi h (2 - xi h)) t_b with
-// h = 1 - b.c, the far end of an arc between nearly antipodal b and c came out as -b: 2 - xi h cancels, and
-// c's small offset from -b was lost. Such arcs occur in fan triangles that are nearly hemispheres (x close to the
-// light's plane, above the triangle): on random lights seen from 1e-14..1e-2 of their size off their plane,
-// samples up to 1.6e-8 rad outside in double (test_polygon.cpp, SolidAngleSamplesLieInsideTheLightSeenFromCloseToItsPlane;
-// our remedy, issue 4).
+// distance from antipodal and carries their rounding. Written from b alone, as b (1 - xi h) + sqrt(xi h (2 - xi h)) t_b
+// with h = 1 - b.c, the far end of an arc between nearly antipodal b and c came out as -b: 2 - xi h cancels, and c's
+// small offset from -b was lost. Such arcs occur in fan triangles that are nearly hemispheres (x close to the light's
+// plane, above the triangle): on random lights seen from 1e-14..1e-2 of their size off their plane, samples up
+// to 1.6e-8 rad outside in double (test_polygon.cpp, SolidAngleSamplesLieInsideTheLightSeenFromCloseToItsPlane; our
+// remedy, issue 4).
 template <class T> Vec3<T> sample_arc(const Vec3<T>& b, const Vec3<T>& d, T xi) {
   const Vec3<T> c = b + d, sum = b + c;
   T sh = d.norm() / T(2), ch = sum.norm() / T(2);

@@ -23,7 +23,8 @@
 //              (using (c_z + r_z)(r_z - c_z) = r_y^2 - h^2 = t_y^2 w_dx^2 and r_z = w_dx r_y), so that
 //      1 - s_y^2 = (1 - m) d_z / (t_y + d_z),  1 - m = -2 h v / (r_z - c_z) >= 0,
 //      1 - k^2 = 1 - (r_y^2 - h^2) w_dx^2 / (r_z - c_z)^2 = -h (2 v w_dx r_y - h (v^2 + w_dx^2)) / (r_z - c_z)^2 >= 0
-//              (Case 3, h < 0; k = (c_z + r_z) / t_y), and Case 3's lift, d on the unit sphere and w = (w_x, s_y d_y, k d_z):
+//              (Case 3, h < 0; k = (c_z + r_z) / t_y), and Case 3's lift, d on the unit sphere and w = (w_x, s_y d_y, k
+//              d_z):
 //      w_x^2 = 1 - w_y^2 - w_z^2 = d_x^2 + (1 - s_y^2) d_y^2 + (1 - k^2) d_z^2,
 //    a sum of non-negative terms where 1 - w_y^2 - w_z^2 cancels for a sample near the lune's flat side (w_x ~ 0,
 //    e.g. a cap of 90 deg - 0.02 deg with its centre on the horizon, fuzz_projected_cap_double 71f5a077). The
@@ -44,8 +45,8 @@
 //  * pdf is per solid angle: the paper's density p w.r.t. projected solid angle times cos = n.w.
 #pragma once
 
-#include <boost/math/tools/roots.hpp>
 #include <array>
+#include <boost/math/tools/roots.hpp>
 #include <cstdint>
 
 #include "warpcheck/core.h"
@@ -86,8 +87,8 @@ template <class T> T unit_disk_area_left_of(T x, T hh) {
 template <class T> struct CutDiskX {
   T x = T(0);
   T half_height = T(1);
-  T inv_density = T(1);  // 1 / density of x per unit disk area when the left-area is uniform (1 for the exact
-                         // inverse); kept inverted so that a sample's pdf costs one division
+  T inv_density = T(1);       // 1 / density of x per unit disk area when the left-area is uniform (1 for the exact
+                              // inverse); kept inverted so that a sample's pdf costs one division
   T one_minus_abs_x = T(-1);  // 1 - |x| where known without cancellation (quintic: q); -1 (unknown) otherwise
   T half_height2 = T(-1);     // half_height^2 (before its square root; quintic), else -1
   T density() const { return T(1) / inv_density; }
@@ -139,12 +140,16 @@ template <class T> constexpr T kQuinticKappa = kQuinticE0<T> / (kPi<T> / T(2));
 
 // The quintic g of Alg. 5 (Horner) and its derivative.
 template <class T> T quintic_g(T s) {
-  return (((((T(-0.0079908617) * s + T(0.0238255409)) * s - T(0.0283903598)) * s + T(0.0198450184)) * s -
-           T(0.0574433620)) * s + T(0.7400712465));
+  return (
+      ((((T(-0.0079908617) * s + T(0.0238255409)) * s - T(0.0283903598)) * s + T(0.0198450184)) * s - T(0.0574433620)) *
+          s +
+      T(0.7400712465));
 }
 template <class T> T quintic_g_prime(T s) {
   return ((((T(5) * T(-0.0079908617) * s + T(4) * T(0.0238255409)) * s - T(3) * T(0.0283903598)) * s +
-           T(2) * T(0.0198450184)) * s - T(0.0574433620));
+           T(2) * T(0.0198450184)) *
+              s -
+          T(0.0574433620));
 }
 
 // Alg. 5 exactly as published: d_x for the left-area a in [0, pi] (the paper's A = a - pi/2).
@@ -192,12 +197,14 @@ template <class T, CutDiskInverse M>
     // er^(2/3): for float by the division-free root of core.h (issue 9: the Halley steps' divisions of cube_root were
     // on the sample's critical path), else cube_root(er^2).
     T er23;
-    if constexpr (std::is_same_v<T, float>) er23 = cube_root_squared_for_float(er);
-    else er23 = cube_root(er * er);
+    if constexpr (std::is_same_v<T, float>)
+      er23 = cube_root_squared_for_float(er);
+    else
+      er23 = cube_root(er * er);
     const T q = std::min(T(1), quintic_g(s) * er23);
-    const T m = T(1) - q;  // |d_x|
+    const T m = T(1) - q;                         // |d_x|
     out.x = std::copysign(m, a - kPi<T> / T(2));  // -m where a < pi/2 (m >= 0), without a branch
-    const T hh2 = q * (T(2) - q);  // 1 - m^2 = (1 - m)(1 + m)
+    const T hh2 = q * (T(2) - q);                 // 1 - m^2 = (1 - m)(1 + m)
     out.half_height = std::sqrt(hh2);
     out.inv_density = kQuinticKappa<T> * quintic_inverse_density(s, er, q);  // d er / d a = kappa
     out.one_minus_abs_x = q;
@@ -261,9 +268,9 @@ template <class T> struct Piece {
 
 template <class T> struct ProjectedCapView {
   NoSample reason = NoSample::kNone;
-  int which_case = 4;   // 1: entirely above, 2: mostly above, 3: mostly below (Sec. 3.2)
-  SphereView<T> sphere;  // validation, distance, the cap (shared with the sphere kernels)
-  Vec3<T> x, y, z;       // local frame (Alg. 1)
+  int which_case = 4;       // 1: entirely above, 2: mostly above, 3: mostly below (Sec. 3.2)
+  SphereView<T> sphere;     // validation, distance, the cap (shared with the sphere kernels)
+  Vec3<T> x, y, z;          // local frame (Alg. 1)
   T h = T(0), w_dx = T(0);  // n.w_d and the horizontal length of w_d
   T r_x = T(0), r_y = T(0), r_z = T(0), c_x = T(0), c_z = T(0), t_x = T(0), t_y = T(0), v = T(0);
   // Pieces: ellipse (Cases 1-2, u0 in [0, tau)), mirrored disk (Case 2, u0 in [tau, 1]), lune (Case 3).
@@ -399,7 +406,7 @@ template <class T> ProjectedCapView<T> make_projected_cap_view(const SphereLight
     p.tau = T(1);
   } else {
     // chord2 = r_y^2 - h^2 > 0 (above)
-    p.t_x = v / p.w_dx;                                       // w_dx >= v > 0 here
+    p.t_x = v / p.w_dx;  // w_dx >= v > 0 here
     p.t_y = std::sqrt(chord2) / p.w_dx;
     p.area_d = cut_disk_area_from_angle(std::atan2(std::sqrt(chord2), v));  // pi/2 - A(t_x)
     p.quintic_area_d = cut_disk_preimage<T, CutDiskInverse::kQuintic>(-p.t_x, p.t_y).left_area;
@@ -422,8 +429,8 @@ template <class T> ProjectedCapView<T> make_projected_cap_view(const SphereLight
       // Case 3 (Alg. 4).
       p.which_case = 3;
       p.rz_minus_cz = p.w_dx * ry - h * v;
-      p.top = chord2 / p.rz_minus_cz;                          // c_z + r_z
-      p.k = std::sqrt(chord2) * p.w_dx / p.rz_minus_cz;        // (c_z + r_z) / t_y
+      p.top = chord2 / p.rz_minus_cz;                    // c_z + r_z
+      p.k = std::sqrt(chord2) * p.w_dx / p.rz_minus_cz;  // (c_z + r_z) / t_y
       // Header comment (Case 3 without cancellation): m = (c_z + r_z) / (r_z - c_z), 1 - m = -2 h v / (r_z - c_z),
       // 1 - k^2 = q (2 v w_dx r_y / (r_z - c_z) - h (v^2 + w_dx^2) / (r_z - c_z)) with q = -h / (r_z - c_z); all
       // terms >= 0 for h < 0, and no square of r_z - c_z (which underflows for r_y ~ 1e-154).
@@ -449,9 +456,7 @@ namespace projected_cap_detail {
 // without cancellation (header comment). t_y + d_z >= t_y >= sqrt(denorm_min) wherever Case 3 has an area (r_y^2 -
 // h^2 > 0), so its reciprocal is finite; the guard keeps a lune without width from dividing by zero (found by
 // fuzz_projected_cap_double under UBSan's float-divide-by-zero, issue 7).
-template <class T> struct Case3Sy {
-  T s_y, one_minus_sy2;
-};
+template <class T> struct Case3Sy { T s_y, one_minus_sy2; };
 template <class T> Case3Sy<T> case3_sy(const ProjectedCapView<T>& p, T d_z) {
   const T den = p.t_y + d_z;
   if (!(den > T(0))) return {T(0), T(0)};
@@ -490,9 +495,8 @@ template <class T> struct Local {
 // one_minus_abs_dx: 1 - |d_x| if the caller has it without cancellation, else negative (then hh^2 / (1 + d_x) is
 // used for d_x > 0); hh2: hh^2 if the caller has it before hh (then the ellipse's height does not wait for hh),
 // else negative.
-template <class T>
-Local<T> disk_to_local(const ProjectedCapView<T>& p, int piece, T dx, T hh, T u1, T inv_disk_density,
-                       T one_minus_abs_dx = T(-1), T hh2 = T(-1)) {
+template <class T> Local<T> disk_to_local(const ProjectedCapView<T>& p, int piece, T dx, T hh, T u1, T inv_disk_density,
+                                          T one_minus_abs_dx = T(-1), T hh2 = T(-1)) {
   Local<T> o;
   const T dy = (T(2) * u1 - T(1)) * hh;
   const auto disk_z = [&] { return T(2) * hh * std::sqrt(u1 * (T(1) - u1)); };  // d_z (the ellipse may not need it)
@@ -558,8 +562,8 @@ Local<T> disk_to_local(const ProjectedCapView<T>& p, int piece, T dx, T hh, T u1
 // and 1 - c_x from the view (a light of angular radius 2e-3 has r_x ~ 1e-6 near the horizon, below float's
 // resolution of w_x ~ 1), and the unit disk's half-height at d_x is sqrt(d_y^2 + d_z^2) (= sqrt(1 - d_x^2) on
 // the unit sphere, without the cancellation of 1 - d_x^2 when |d_x| ~ 1).
-template <class T> bool local_to_disk(const ProjectedCapView<T>& p, int piece, const Vec3<T>& w, T& dx, T& dy,
-                                      T& hh, T& area_factor) {
+template <class T>
+bool local_to_disk(const ProjectedCapView<T>& p, int piece, const Vec3<T>& w, T& dx, T& dy, T& hh, T& area_factor) {
   if (piece == 0) {
     if (!(p.r_x > T(0))) return false;
     dx = w.x() > T(0.5) ? (p.one_minus_cx - (w.y() * w.y() + w.z() * w.z()) / (T(1) + w.x())) / p.r_x
@@ -608,12 +612,18 @@ template <class T> T piece_right_area(const Piece<T>& pc, T u0) {
 template <class T, CutDiskInverse M> int pieces(const ProjectedCapView<T>& p, std::array<Piece<T>, 2>& out) {
   constexpr bool q = M == CutDiskInverse::kQuintic;
   switch (p.which_case) {
-    case 1: out[0] = {0, T(0), T(1), T(0), kPi<T>, T(0)}; return 1;
+    case 1:
+      out[0] = {0, T(0), T(1), T(0), kPi<T>, T(0)};
+      return 1;
     case 2: {
       int n = 0;
       if (p.area_e > T(0)) {
         const T ae = q ? p.quintic_area_e_unit : p.area_e_unit;
-        out[n++] = {0, T(0), p.tau, T(0), q ? ae / p.tau : p.total / (p.r_x * p.r_y),
+        out[n++] = {0,
+                    T(0),
+                    p.tau,
+                    T(0),
+                    q ? ae / p.tau : p.total / (p.r_x * p.r_y),
                     q ? p.quintic_right_e_unit : p.right_e_unit};
       }
       // tau rounds to 1 when A_D < eps A_E / 2: the disk piece then has no u0 range (and 1 / (1 - tau) is a
@@ -630,7 +640,8 @@ template <class T, CutDiskInverse M> int pieces(const ProjectedCapView<T>& p, st
       out[0] = {2, T(0), T(1), ad, -ad};
       return 1;
     }
-    default: return 0;
+    default:
+      return 0;
   }
 }
 
@@ -659,7 +670,8 @@ template <class T, CutDiskInverse M> T pdf_local(const ProjectedCapView<T>& p, c
       if (pre.left_area < a_lo || pre.left_area > a_hi) continue;
     }
     if (u) {
-      (*u)[0] = std::clamp(pc.alpha == T(0) ? pre.left_area / pc.beta : T(1) - pre.left_area / pc.alpha, pc.u_lo, pc.u_hi);
+      (*u)[0] =
+          std::clamp(pc.alpha == T(0) ? pre.left_area / pc.beta : T(1) - pre.left_area / pc.alpha, pc.u_lo, pc.u_hi);
       (*u)[1] = hh > T(0) ? std::clamp((dy / hh + T(1)) / T(2), T(0), T(1)) : T(0.5);
     }
     // |beta| area underflows to 0 for a piece whose left-area scale is subnormal (a float lune piece with
@@ -706,8 +718,10 @@ DirectionSample<T> sample_projected_spherical_cap(const ProjectedCapView<T>& p, 
   }
   if (!(pdf > T(0)) || !std::isfinite(pdf)) return DirectionSample<T>::none(NoSample::kOnSilhouette);
   DirectionSample<T> s;
-  if constexpr (fast) s.direction = p.to_world(loc.w) * near_unit_renormalization_factor(loc.norm2);
-  else s.direction = renormalized(p.to_world(loc.w));
+  if constexpr (fast)
+    s.direction = p.to_world(loc.w) * near_unit_renormalization_factor(loc.norm2);
+  else
+    s.direction = renormalized(p.to_world(loc.w));
   s.pdf = pdf;
   return s;
 }
@@ -732,8 +746,8 @@ T pdf_projected_spherical_cap(const SphereLightGeometry<T>& g, const Vec3<T>& w)
   return pdf_projected_spherical_cap<T, M>(make_projected_cap_view(g), w);
 }
 
-// Inverse map: the primary sample (u0, u1) that the warp with inverse M maps to w. False outside the support. With M = kExact applied to samples of
-// the quintic warp, u0 measures the quintic's error in primary sample space.
+// Inverse map: the primary sample (u0, u1) that the warp with inverse M maps to w. False outside the support. With M =
+// kExact applied to samples of the quintic warp, u0 measures the quintic's error in primary sample space.
 template <class T, CutDiskInverse M = CutDiskInverse::kQuintic>
 bool invert_projected_spherical_cap(const ProjectedCapView<T>& p, const Vec3<T>& w, Vec2<T>& u) {
   if (!p.valid() || !all_finite(w)) return false;

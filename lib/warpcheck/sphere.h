@@ -50,7 +50,8 @@ template <class T> SphereView<T> make_sphere_view(const SphereLightGeometry<T>& 
   const Vec3<T>& x = g.shading.position;
   const Vec3<T>& c = g.light.center;
   const T r = g.light.radius;
-  if (!all_finite(x) || !all_finite(c) || !all_finite(g.shading.normal) || !std::isfinite(r)) return v.reason = NoSample::kNonFinite, v;
+  if (!all_finite(x) || !all_finite(c) || !all_finite(g.shading.normal) || !std::isfinite(r))
+    return v.reason = NoSample::kNonFinite, v;
   if (!normalize_normal(g.shading.normal, v.normal)) return v.reason = NoSample::kBadNormal, v;
   if (r < T(0)) return v.reason = NoSample::kNegativeSize, v;
   if (r == T(0)) return v.reason = NoSample::kZeroSize, v;
@@ -112,8 +113,8 @@ template <class T> T pdf_sphere_solid_angle(const SphereLightGeometry<T>& g, con
 
 // ---- Visible-cap area sampling -------------------------------------------------------------------------
 
-template <class T> DirectionSample<T> sample_sphere_visible_area(const SphereView<T>& v,
-                                                                 const SphereLight<T>& light, const Vec2<T>& u) {
+template <class T>
+DirectionSample<T> sample_sphere_visible_area(const SphereView<T>& v, const SphereLight<T>& light, const Vec2<T>& u) {
   if (!v.valid()) return DirectionSample<T>::none(v.reason);
   const T r = light.radius, d = v.distance;
   const T s = r / d;

@@ -37,8 +37,7 @@ template <class T> SphericalRectangleView<T> make_spherical_rectangle_view(const
   const T exl = ex.norm(), eyl = ey.norm();
   // A rectangle: orthogonal edges and V2 = V0 + ex + ey (to the precision of the input).
   const T tol = T(64) * std::sqrt(std::numeric_limits<T>::epsilon());
-  if (std::abs(ex.dot(ey)) > tol * exl * eyl ||
-      (g.light.vertices[2] - s - ex - ey).norm() > tol * (exl + eyl))
+  if (std::abs(ex.dot(ey)) > tol * exl * eyl || (g.light.vertices[2] - s - ex - ey).norm() > tol * (exl + eyl))
     return v.reason = NoSample::kInvalidGeometry, v;
   bool above = false;
   for (int i = 0; i < 4; ++i) above = above || pv.local.v[i].z() > T(0);
@@ -68,14 +67,15 @@ template <class T> SphericalRectangleView<T> make_spherical_rectangle_view(const
   return v;
 }
 
-template <class T> DirectionSample<T> sample_spherical_rectangle(const SphericalRectangleView<T>& v, const Vec2<T>& xi) {
+template <class T>
+DirectionSample<T> sample_spherical_rectangle(const SphericalRectangleView<T>& v, const Vec2<T>& xi) {
   if (!v.valid()) return DirectionSample<T>::none(v.reason);
   const T au = xi[0] * v.solid_angle + v.k;
   // sin(au) = 0 at the ends of the range: fu is +-infinite there (its limit; Urena et al. 2013 Sec. 4); written
   // without the division, which the float-divide-by-zero sanitizer flags (fuzz_spherical_rectangle_* replay).
   const T fu_num = std::cos(au) * v.b0 - v.b1, sin_au = std::sin(au);
   const T fu = sin_au != T(0) ? fu_num / sin_au
-                               : std::copysign(std::numeric_limits<T>::infinity(), fu_num) * std::copysign(T(1), sin_au);
+                              : std::copysign(std::numeric_limits<T>::infinity(), fu_num) * std::copysign(T(1), sin_au);
   // The same for the other quotients below: a zero denominator takes the clamped limit instead of dividing.
   const T cu_den = std::sqrt(fu * fu + v.b0 * v.b0), cu_sign = fu > T(0) ? T(1) : T(-1);
   T cu = cu_den > T(0) ? cu_sign / cu_den : cu_sign;

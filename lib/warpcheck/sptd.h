@@ -80,9 +80,7 @@ namespace warpcheck {
 // ---- The pivot transformation (Sec. 3.2) -------------------------------------------------------------------
 
 // A pivot r_p must lie strictly inside the unit sphere.
-template <class T> bool valid_pivot(const Vec3<T>& rp) {
-  return all_finite(rp) && rp.squaredNorm() < T(1);
-}
+template <class T> bool valid_pivot(const Vec3<T>& rp) { return all_finite(rp) && rp.squaredNorm() < T(1); }
 
 // k = 1 - |r_p|^2 as (1 - |r_p|)(1 + |r_p|).
 template <class T> T pivot_k(const Vec3<T>& rp) {
@@ -145,9 +143,8 @@ template <class T> T pivot_jacobian(const Vec3<T>& w, const Vec3<T>& rp) { retur
 // k o1 / |o1|^2 with o1 = pivot_offset(p1) = r_p - p1 (the anti-inversion form); the image circle's centre is the
 // midpoint m = r_p + h of g1 and g2 (the ends of a diameter), h = (q1 + q2) / 2 with q_i = g_i - r_p; the axis is
 // m / |m|, so axis - r_p = h + m (1 - |m|) / |m|, and as |r_p + q_i| = 1, 1 - |m|^2 = |q1 - q2|^2 / 4 exactly.
-template <class T>
-Cap<T> pivot_transform_cap(const Cap<T>& c, const Vec3<T>& rp, T k, Vec3<T>* axis_minus_pivot = nullptr,
-                           bool* relative = nullptr) {
+template <class T> Cap<T> pivot_transform_cap(const Cap<T>& c, const Vec3<T>& rp, T k,
+                                              Vec3<T>* axis_minus_pivot = nullptr, bool* relative = nullptr) {
   if (relative) *relative = false;
   if (c.one_minus_cos >= T(2)) return Cap<T>{c.axis, T(2)};  // the whole sphere maps onto itself
   const Vec3<T>& wc = c.axis;
@@ -165,7 +162,7 @@ Cap<T> pivot_transform_cap(const Cap<T>& c, const Vec3<T>& rp, T k, Vec3<T>* axi
   const T tn = t.stableNorm();
   constexpr T e = std::numeric_limits<T>::epsilon();
   t = tn > T(64) * e * rp.stableNorm() && tn > std::numeric_limits<T>::min() / e ? Vec3<T>(t / tn)
-                                                                                : Frame<T>::from_z(wc).x;
+                                                                                 : Frame<T>::from_z(wc).x;
   const T omc = c.one_minus_cos;
   const T cos_a = T(1) - omc, sin_a = std::sqrt(std::max(T(0), omc * (T(2) - omc)));
   // Fig. 3 (2)-(3): the boundary points in that plane and their images.
@@ -176,7 +173,8 @@ Cap<T> pivot_transform_cap(const Cap<T>& c, const Vec3<T>& rp, T k, Vec3<T>* axi
   // Eq. 6 (in-plane bisector), robust for image caps of any size.
   const Vec3<T> sum = g1 + g2, diff = g1 - g2;
   Vec3<T> axis;
-  if (sum.squaredNorm() >= diff.squaredNorm()) axis = sum / sum.norm();
+  if (sum.squaredNorm() >= diff.squaredNorm())
+    axis = sum / sum.norm();
   else {
     const Vec3<T> m = wc.cross(t).cross(diff);  // in the plane, orthogonal to g1 - g2
     axis = m / m.norm();
@@ -259,17 +257,17 @@ template <class T> struct CosineCapView {
   NoSample reason = NoSample::kNone;
   Cap<T> cap;
   Vec3<T> ex = Vec3<T>::Zero(), ey = Vec3<T>::Zero(), ez = Vec3<T>::Zero();  // ez = n; ex towards the cap axis
-  T cos_a = 0, sin_a = 0;      // cap half-angle alpha
-  T cos_t = 0, sin_t = 0;      // angle t between the cap axis and n
-  T xc = 0, A = 0, x0 = 0;     // ellipse centre and x semi-axis; x >= x0: full chord side
-  T seg0 = 0;                  // area of the unit disk right of x0, without cancellation (make_cosine_cap_view)
-  bool ellipse_only = false;   // R = E (cap entirely above the horizon)
+  T cos_a = 0, sin_a = 0;                                                    // cap half-angle alpha
+  T cos_t = 0, sin_t = 0;                                                    // angle t between the cap axis and n
+  T xc = 0, A = 0, x0 = 0;    // ellipse centre and x semi-axis; x >= x0: full chord side
+  T seg0 = 0;                 // area of the unit disk right of x0, without cancellation (make_cosine_cap_view)
+  bool ellipse_only = false;  // R = E (cap entirely above the horizon)
   // The crescent with its tip at x0 in (-1, 1) (cos t < 0), where E touches the unit circle at (x0, +-c0):
   // E's normalised abscissa tau0 = (x0 - x_c) / A there and its normalised half-height n0 = sqrt(1 - tau0^2)
   // (both computed from c0, make_cosine_cap_view).
   bool tip = false;
   T c0 = 0, tau0 = 0, n0 = 0;
-  T area = 0;                  // projected solid angle of (cap, upper hemisphere) = area of R
+  T area = 0;  // projected solid angle of (cap, upper hemisphere) = area of R
 
   bool valid() const { return reason == NoSample::kNone; }
 
@@ -336,8 +334,10 @@ template <class T> struct CosineCapView {
       const T rise_n = sum_n > T(0) ? v * sum_tau / sum_n : T(0);
       ellipse = sin_a * A * cut_disk_area_from_angle(std::atan2(std::hypot(v, rise_n), std::hypot(sum_tau, sum_n)));
     }
-    if (A > T(0) && s / A < v_end) polygon = s * ch.w / T(2);
-    else polygon = (c0 * (s - A * v_end) + c * s) / T(2);
+    if (A > T(0) && s / A < v_end)
+      polygon = s * ch.w / T(2);
+    else
+      polygon = (c0 * (s - A * v_end) + c * s) / T(2);
     return T(2) * std::max(T(0), circle - ellipse + polygon);
   }
   // Half-height of E at abscissa x (0 outside it).
@@ -361,14 +361,18 @@ template <class T> CosineCapView<T> make_cosine_cap_view(const Cap<T>& cap, cons
   v.cos_t = std::clamp(cap.axis.dot(n), T(-1), T(1));
   const Vec3<T> tangential = cap.axis - v.cos_t * n;
   v.sin_t = cap.axis.cross(n).norm();
-  if (v.sin_t > T(0) && tangential.norm() > T(0)) v.ex = tangential / tangential.norm();
-  else v.ex = Frame<T>::from_z(n).x, v.sin_t = T(0);
+  if (v.sin_t > T(0) && tangential.norm() > T(0))
+    v.ex = tangential / tangential.norm();
+  else
+    v.ex = Frame<T>::from_z(n).x, v.sin_t = T(0);
   v.ey = v.ez.cross(v.ex);
   v.xc = v.sin_t * v.cos_a;
   v.A = v.sin_a * std::abs(v.cos_t);
   // x >= x0 <=> cos(alpha) - x sin(t) <= 0; clamped to +-2 (only comparisons with x in [-1, 1] matter).
-  if (v.sin_t > T(0)) v.x0 = std::clamp(v.cos_a / v.sin_t, T(-2), T(2));
-  else v.x0 = v.cos_a > T(0) ? T(2) : T(-2);
+  if (v.sin_t > T(0))
+    v.x0 = std::clamp(v.cos_a / v.sin_t, T(-2), T(2));
+  else
+    v.x0 = v.cos_a > T(0) ? T(2) : T(-2);
   // The disk's area right of x0 as a segment area (cdf): x0 itself is known to an absolute eps either way.
   v.seg0 = v.x0 >= T(1) ? T(0) : v.x0 <= T(-1) ? kPi<T> : CosineCapView<T>::disk_right_of(v.x0);
   // R = E exactly when the cap lies entirely above the horizon, alpha + t <= pi/2, i.e. cos(alpha) >= sin(t) (both
@@ -439,8 +443,8 @@ template <class T> T cap_intersection_solid_angle(const Cap<T>& c1, const Cap<T>
   T a1 = c1.solid_angle(), a2 = c2.solid_angle();
   if (p1 > p2) std::swap(p1, p2), std::swap(a1, a2);
   const T pd = angle_between_unit(c1.axis, c2.axis);
-  if (p2 - p1 >= pd) return a1;                                    // the smaller cap inside the larger
-  if (p1 + p2 <= pd) return T(0);                                  // disjoint
+  if (p2 - p1 >= pd) return a1;                                                   // the smaller cap inside the larger
+  if (p1 + p2 <= pd) return T(0);                                                 // disjoint
   if (p1 + p2 + pd >= kTwoPi<T>) return std::max(T(0), a1 + a2 - T(4) * kPi<T>);  // union covers the sphere
   const T c1c = std::cos(p1), c2c = std::cos(p2), cd = std::cos(pd);
   const T s1 = std::sin(p1), s2 = std::sin(p2), sd = std::sin(pd);
@@ -467,8 +471,7 @@ template <class T> T cap_intersection_solid_angle_approx(const Cap<T>& c1, const
 // (1 / 4 pi) |g(C) n g(H)|.
 template <class T> T sptd_uniform_two_cap_integral(const Vec3<T>& rp, const Cap<T>& c, const Cap<T>& h) {
   const T k = pivot_k(rp);
-  return cap_intersection_solid_angle(pivot_transform_cap(c, rp, k), pivot_transform_cap(h, rp, k)) /
-         (T(4) * kPi<T>);
+  return cap_intersection_solid_angle(pivot_transform_cap(c, rp, k), pivot_transform_cap(h, rp, k)) / (T(4) * kPi<T>);
 }
 
 // ---- Sampling D_std over a cap -----------------------------------------------------------------------------
@@ -501,8 +504,10 @@ template <class T> Vec3<T> sample_cosine_cap_direction(const CosineCapView<T>& v
     // R's chord at x. Hand-rolled inversion because the CDF is ours; the root finder is Boost's.
     const T target = u[0] * v.area;
     T lo = T(-1), hi = T(1);
-    if (v.cos_t >= T(0)) lo = std::max(lo, v.xc - v.A);
-    else lo = std::max(lo, std::min(v.x0, T(1)));
+    if (v.cos_t >= T(0))
+      lo = std::max(lo, v.xc - v.A);
+    else
+      lo = std::max(lo, std::min(v.x0, T(1)));
     // Right of x_full (x0 for cos t >= 0, E's right end x_c + A for the crescent) R is the full disk chord, and the
     // area right of x is disk_right_of(x): there x is found from that upper tail, (1 - u0) area, which keeps its
     // relative precision as u0 -> 1 where the CDF's u0 area - cdf(x) cancels (float: pdf(dir) and the warp's area
@@ -525,12 +530,15 @@ template <class T> Vec3<T> sample_cosine_cap_direction(const CosineCapView<T>& v
     // The unknown q is theta in the upper tail, s = x - x0 in the crescent with a tip, and x otherwise.
     auto f = [&](T q) {
       return upper_tail ? CosineCapView<T>::disk_right_of_angle(q) - upper
-                        : by_s ? v.crescent_cdf(q) - target : v.cdf(q) - target;
+             : by_s     ? v.crescent_cdf(q) - target
+                        : v.cdf(q) - target;
     };
     T q;
     const T flo = f(lo), fhi = f(hi);
-    if (flo >= T(0)) q = lo;
-    else if (fhi <= T(0)) q = hi;
+    if (flo >= T(0))
+      q = lo;
+    else if (fhi <= T(0))
+      q = hi;
     else {
       std::uintmax_t iters = 200;
       const auto tol = boost::math::tools::eps_tolerance<T>(std::numeric_limits<T>::digits - 2);
@@ -557,8 +565,10 @@ template <class T> Vec3<T> sample_cosine_cap_direction(const CosineCapView<T>& v
     // the inversion's piece, not by comparing a rounded cos(theta) with x0.
     const T one_minus_abs_s = T(2) * std::min(u[1], T(1) - u[1]);
     T c_minus_abs_y;
-    if (upper_tail || (v.cos_t >= T(0) && x >= v.x0)) y = s * c, c_minus_abs_y = c * one_minus_abs_s;
-    else if (v.cos_t >= T(0)) y = s * m, c_minus_abs_y = w + m * one_minus_abs_s;
+    if (upper_tail || (v.cos_t >= T(0) && x >= v.x0))
+      y = s * c, c_minus_abs_y = c * one_minus_abs_s;
+    else if (v.cos_t >= T(0))
+      y = s * m, c_minus_abs_y = w + m * one_minus_abs_s;
     else {
       y = std::copysign(m + w * std::abs(s), s);  // the crescent: jumps across E at u1 = 1/2
       c_minus_abs_y = w * one_minus_abs_s;
@@ -589,7 +599,7 @@ template <class T> struct SptdCapView {
   NoSample reason = NoSample::kNone;
   Sptd<T> sptd;
   T k = 0;
-  Cap<T> cap, image;        // C and g(C)
+  Cap<T> cap, image;  // C and g(C)
   // Uniform base with a small image: g(C)'s axis minus r_p (pivot_transform_cap); samples and densities are then
   // formed from offsets to r_p, never from unit vectors near it.
   bool image_relative = false;
@@ -658,8 +668,9 @@ template <class T> T pdf_sptd_cap(const SptdCapView<T>& v, const Vec3<T>& w) {
   // 2 - (1 - cos), is then exact), each with a relative slack of 8 eps plus a chord of 4 eps for the rounding of
   // unit directions; a relative slack on the chord to the axis would be ~1e-3 rad near the antipode in float.
   const T e = std::numeric_limits<T>::epsilon(), omc = v.cap.one_minus_cos;
-  const bool in_c = omc <= T(1) ? (wu - v.cap.axis).squaredNorm() <= T(2) * omc * (T(1) + T(8) * e) + T(16) * e * e
-                                : (wu + v.cap.axis).squaredNorm() >= T(2) * (T(2) - omc) * (T(1) - T(8) * e) - T(16) * e * e;
+  const bool in_c = omc <= T(1)
+                        ? (wu - v.cap.axis).squaredNorm() <= T(2) * omc * (T(1) + T(8) * e) + T(16) * e * e
+                        : (wu + v.cap.axis).squaredNorm() >= T(2) * (T(2) - omc) * (T(1) - T(8) * e) - T(16) * e * e;
   if (!in_c) return T(0);
   T p;
   if (v.image_relative) {
@@ -729,7 +740,9 @@ template <class T> T hg_to_pivot(T g) {
 
 // The pivot phase function as an SPTD geometry: pivot g_p w_o, uniform base, over a cap (the whole sphere
 // by default).
-template <class T> SptdCapGeometry<T> pivot_phase_geometry(const Vec3<T>& wo, T gp, const Cap<T>& cap = Cap<T>{Vec3<T>(T(0), T(0), T(1)), T(2)}) {
+template <class T>
+SptdCapGeometry<T> pivot_phase_geometry(const Vec3<T>& wo, T gp,
+                                        const Cap<T>& cap = Cap<T>{Vec3<T>(T(0), T(0), T(1)), T(2)}) {
   SptdCapGeometry<T> g;
   g.sptd.pivot = gp * wo;
   g.sptd.base = SptdBase::kUniform;
@@ -739,8 +752,8 @@ template <class T> SptdCapGeometry<T> pivot_phase_geometry(const Vec3<T>& wo, T 
 
 // Sec. 6.2, Fig. 17 (right): the pivot phase function sampled jointly with a sphere light, i.e. restricted
 // to the cone the light subtends. The density is normalised over that cone.
-template <class T> SptdCapGeometry<T> pivot_phase_sphere_light_geometry(const Vec3<T>& wo, T gp,
-                                                                       const SphereLightGeometry<T>& light) {
+template <class T>
+SptdCapGeometry<T> pivot_phase_sphere_light_geometry(const Vec3<T>& wo, T gp, const SphereLightGeometry<T>& light) {
   // A medium has no horizon: aim the shading normal at the light so that only the light's own validity counts.
   SphereLightGeometry<T> g = light;
   g.shading.normal = light.light.center - light.shading.position;

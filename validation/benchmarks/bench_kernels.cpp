@@ -63,7 +63,8 @@ template <class T> std::vector<SphereLightGeometry<T>> sphere_scene(double qz) {
   while (int(out.size()) < kLights) {
     const double x = U(rng), y = U(rng);
     if (x * x + y * y + qz * qz <= 1.01 * 1.01) continue;
-    out.push_back({ShadingPoint<T>{Vec3<T>(T(x), T(y), 0), Vec3<T>(0, 0, 1)}, SphereLight<T>{Vec3<T>(0, 0, T(qz)), T(1)}});
+    out.push_back(
+        {ShadingPoint<T>{Vec3<T>(T(x), T(y), 0), Vec3<T>(0, 0, 1)}, SphereLight<T>{Vec3<T>(0, 0, T(qz)), T(1)}});
   }
   return out;
 }
@@ -163,30 +164,33 @@ template <class T> void register_all() {
       benchmark::RegisterBenchmark(("sphere_baseline" + suffix).c_str(),
                                    [=](benchmark::State& s) { run_baseline<T>(s, scene, spl); });
       benchmark::RegisterBenchmark(("sphere_solid_angle" + suffix).c_str(), [=](benchmark::State& s) {
-        run<T>(s, scene, [](const auto& g) { return make_sphere_view(g); },
-               [](const auto& v, const Vec2<T>& u) { return sample_sphere_solid_angle(v, u); }, spl);
+        run<T>(
+            s, scene, [](const auto& g) { return make_sphere_view(g); },
+            [](const auto& v, const Vec2<T>& u) { return sample_sphere_solid_angle(v, u); }, spl);
       });
       benchmark::RegisterBenchmark(("sphere_visible_area" + suffix).c_str(), [=](benchmark::State& s) {
-        run<T>(s, scene, [](const auto& g) { return std::make_pair(make_sphere_view(g), g.light); },
-               [](const auto& v, const Vec2<T>& u) { return sample_sphere_visible_area(v.first, v.second, u); },
-               spl);
+        run<T>(
+            s, scene, [](const auto& g) { return std::make_pair(make_sphere_view(g), g.light); },
+            [](const auto& v, const Vec2<T>& u) { return sample_sphere_visible_area(v.first, v.second, u); }, spl);
       });
       benchmark::RegisterBenchmark(("projected_cap" + suffix).c_str(), [=](benchmark::State& s) {
-        run<T>(s, scene, [](const auto& g) { return make_projected_cap_view(g); },
-               [](const auto& v, const Vec2<T>& u) { return sample_projected_spherical_cap(v, u); }, spl);
+        run<T>(
+            s, scene, [](const auto& g) { return make_projected_cap_view(g); },
+            [](const auto& v, const Vec2<T>& u) { return sample_projected_spherical_cap(v, u); }, spl);
       });
       for (const SptdBase base : {SptdBase::kUniform, SptdBase::kClampedCosine}) {
         const std::string name = base == SptdBase::kUniform ? "sptd_uniform_cap" : "sptd_cosine_cap";
         benchmark::RegisterBenchmark((name + suffix).c_str(), [=](benchmark::State& s) {
-          run<T>(s, scene,
-                 [base](const auto& g) {
-                   SptdCapGeometry<T> c;
-                   c.sptd.pivot = Vec3<T>(T(0.2), T(0.1), T(0.5));
-                   c.sptd.base = base;
-                   c.cap = make_sphere_view(g).cap();
-                   return make_sptd_cap_view(c);
-                 },
-                 [](const auto& v, const Vec2<T>& u) { return sample_sptd_cap(v, u); }, spl);
+          run<T>(
+              s, scene,
+              [base](const auto& g) {
+                SptdCapGeometry<T> c;
+                c.sptd.pivot = Vec3<T>(T(0.2), T(0.1), T(0.5));
+                c.sptd.base = base;
+                c.cap = make_sphere_view(g).cap();
+                return make_sptd_cap_view(c);
+              },
+              [](const auto& v, const Vec2<T>& u) { return sample_sptd_cap(v, u); }, spl);
         });
       }
       if (spl == kManySamples)
@@ -203,41 +207,52 @@ template <class T> void register_all() {
         benchmark::RegisterBenchmark(("polygon_baseline" + suffix).c_str(),
                                      [=](benchmark::State& s) { run_baseline<T>(s, scene, spl); });
         benchmark::RegisterBenchmark(("polygon_solid_angle" + suffix).c_str(), [=](benchmark::State& s) {
-          run<T>(s, scene, [](const auto& g) { return make_polygon_solid_angle_view(g, false); },
-                 [](const auto& v, const Vec2<T>& u) { return sample_polygon_solid_angle(v, u); }, spl);
+          run<T>(
+              s, scene, [](const auto& g) { return make_polygon_solid_angle_view(g, false); },
+              [](const auto& v, const Vec2<T>& u) { return sample_polygon_solid_angle(v, u); }, spl);
         });
         benchmark::RegisterBenchmark(("polygon_solid_angle_clipped" + suffix).c_str(), [=](benchmark::State& s) {
-          run<T>(s, scene, [](const auto& g) { return make_polygon_solid_angle_view(g, true); },
-                 [](const auto& v, const Vec2<T>& u) { return sample_polygon_solid_angle(v, u); }, spl);
+          run<T>(
+              s, scene, [](const auto& g) { return make_polygon_solid_angle_view(g, true); },
+              [](const auto& v, const Vec2<T>& u) { return sample_polygon_solid_angle(v, u); }, spl);
         });
         benchmark::RegisterBenchmark(("polygon_projected" + suffix).c_str(), [=](benchmark::State& s) {
-          run<T>(s, scene, [](const auto& g) { return make_polygon_projected_view<T, false>(g); },
-                 [](const auto& v, const Vec2<T>& u) { return sample_polygon_projected_solid_angle<T, false>(v, u); },
-                 spl);
+          run<T>(
+              s, scene, [](const auto& g) { return make_polygon_projected_view<T, false>(g); },
+              [](const auto& v, const Vec2<T>& u) { return sample_polygon_projected_solid_angle<T, false>(v, u); },
+              spl);
         });
         benchmark::RegisterBenchmark(("polygon_projected_biased" + suffix).c_str(), [=](benchmark::State& s) {
-          run<T>(s, scene, [](const auto& g) { return make_polygon_projected_view<T, true>(g); },
-                 [](const auto& v, const Vec2<T>& u) { return sample_polygon_projected_solid_angle<T, true>(v, u, 0); },
-                 spl);
+          run<T>(
+              s, scene, [](const auto& g) { return make_polygon_projected_view<T, true>(g); },
+              [](const auto& v, const Vec2<T>& u) { return sample_polygon_projected_solid_angle<T, true>(v, u, 0); },
+              spl);
         });
         benchmark::RegisterBenchmark(("polygon_ltc" + suffix).c_str(), [=](benchmark::State& s) {
           Mat3<T> m;
           m << T(0.4115), T(-0.1846), T(-0.4395), T(0.0704), T(0.8373), T(-0.1615), T(0), T(0), T(1);
-          run<T>(s, scene, [m](const auto& g) { return make_ltc_polygon_view(LtcPolygonGeometry<T>{g, m}); },
-                 [](const auto& v, const Vec2<T>& u) { return sample_ltc_polygon(v, u); }, spl);
+          run<T>(
+              s, scene,
+              [m](const auto& g) {
+                return make_ltc_polygon_view(LtcPolygonGeometry<T>{g, m});
+              },
+              [](const auto& v, const Vec2<T>& u) { return sample_ltc_polygon(v, u); }, spl);
         });
         benchmark::RegisterBenchmark(("polygon_arvo" + suffix).c_str(), [=](benchmark::State& s) {
-          run<T>(s, scene, [](const auto& g) { return make_arvo_fan_view(g); },
-                 [](const auto& v, const Vec2<T>& u) { return sample_arvo_triangle_fan(v, u); }, spl);
+          run<T>(
+              s, scene, [](const auto& g) { return make_arvo_fan_view(g); },
+              [](const auto& v, const Vec2<T>& u) { return sample_arvo_triangle_fan(v, u); }, spl);
         });
         benchmark::RegisterBenchmark(("polygon_turk_area" + suffix).c_str(), [=](benchmark::State& s) {
-          run<T>(s, scene, [](const auto& g) { return make_turk_area_view(g); },
-                 [](const auto& v, const Vec2<T>& u) { return sample_turk_area(v, u); }, spl);
+          run<T>(
+              s, scene, [](const auto& g) { return make_turk_area_view(g); },
+              [](const auto& v, const Vec2<T>& u) { return sample_turk_area(v, u); }, spl);
         });
         if (n == 4)
           benchmark::RegisterBenchmark(("spherical_rectangle" + suffix).c_str(), [=](benchmark::State& s) {
-            run<T>(s, scene, [](const auto& g) { return make_spherical_rectangle_view(g); },
-                   [](const auto& v, const Vec2<T>& u) { return sample_spherical_rectangle(v, u); }, spl);
+            run<T>(
+                s, scene, [](const auto& g) { return make_spherical_rectangle_view(g); },
+                [](const auto& v, const Vec2<T>& u) { return sample_spherical_rectangle(v, u); }, spl);
           });
       }
     }

@@ -12,7 +12,8 @@ namespace {
 const warpcheck::cli::Command kCommands[] = {
     {"list", "list kernels and their named configurations", warpcheck::cli::list_main},
     {"validate", "run the validation battery", warpcheck::cli::validate_main},
-    {"worst-case", "search for the worst-case error of a kernel (resumable, shardable)", warpcheck::cli::worst_case_main},
+    {"worst-case", "search for the worst-case error of a kernel (resumable, shardable)",
+     warpcheck::cli::worst_case_main},
     {"merge", "combine worst-case results of shards or runs", warpcheck::cli::merge_main},
     {"report", "write the HTML report of a battery run", warpcheck::cli::report_main},
 };

@@ -52,9 +52,9 @@ int report_main(const std::vector<std::string>& a) {
   if (opt.out_dir.empty()) throw UsageError("--out DIR is required");
   try {
     const auto sum = validation::report::write_report(opt);
-    std::printf("report: %zu kernels, %zu results, %zu failed, %zu known-limitation failures; %zu files; open %s/index.html\n",
-                sum.kernels, sum.results, sum.failures, sum.known_limitation_failures, sum.files.size(),
-                opt.out_dir.c_str());
+    std::printf(
+        "report: %zu kernels, %zu results, %zu failed, %zu known-limitation failures; %zu files; open %s/index.html\n",
+        sum.kernels, sum.results, sum.failures, sum.known_limitation_failures, sum.files.size(), opt.out_dir.c_str());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "warpcheck report: %s\n", e.what());
     return 1;

@@ -172,8 +172,10 @@ std::vector<TestResult> load_results_to_resume(const std::string& path, std::uin
     t.detail = str("detail"), t.known_limitation = str("known_limitation");
     t.statistic = r.at("statistic").is_null() ? std::numeric_limits<double>::quiet_NaN()
                                               : boost::json::value_to<double>(r.at("statistic"));
-    if (!r.at("p_value").is_null()) t.p_value = boost::json::value_to<double>(r.at("p_value"));
-    else t.passed = r.at("passed").as_bool();  // deterministic verdicts are kept; statistical ones re-judged
+    if (!r.at("p_value").is_null())
+      t.p_value = boost::json::value_to<double>(r.at("p_value"));
+    else
+      t.passed = r.at("passed").as_bool();  // deterministic verdicts are kept; statistical ones re-judged
     if (r.contains("map")) {
       const auto& m = r.at("map").as_object();
       t.map_rows = int(m.at("rows").to_number<double>()), t.map_cols = int(m.at("cols").to_number<double>());
@@ -211,9 +213,12 @@ int validate_main(const std::vector<std::string>& a) {
       alpha = parse_double(f, value(), 1e-12, 0.5);
     } else if (f == "--correction") {
       const std::string& v = value();
-      if (v == "holm") corr = Correction::kHolm;
-      else if (v == "sidak") corr = Correction::kSidak;
-      else throw UsageError("--correction must be holm or sidak, got '" + v + "'");
+      if (v == "holm")
+        corr = Correction::kHolm;
+      else if (v == "sidak")
+        corr = Correction::kSidak;
+      else
+        throw UsageError("--correction must be holm or sidak, got '" + v + "'");
     } else if (f == "--threads") {
       opt.threads = int(parse_u64(f, value(), 1, 1024));
     } else if (f == "--json") {
@@ -239,7 +244,8 @@ int validate_main(const std::vector<std::string>& a) {
     // Known limitations are the current registry's policy, not the interrupted run's: re-tag resumed results.
     for (TestResult& r : all)
       for (const Case* c : select_cases(reg, sel))
-        if (c->kernel == r.kernel && c->scalar == r.scalar && c->config == r.config) r.known_limitation = c->known_limitation;
+        if (c->kernel == r.kernel && c->scalar == r.scalar && c->config == r.config)
+          r.known_limitation = c->known_limitation;
     const std::size_t before = cases.size();
     std::erase_if(cases, [&](const Case* c) { return done.count(case_key(c->kernel, c->scalar, c->config)) > 0; });
     std::fprintf(stderr, "resuming %s: %zu cases done, %zu to run\n", json.c_str(), before - cases.size(),

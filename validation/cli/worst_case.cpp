@@ -94,23 +94,34 @@ int worst_case_main(const std::vector<std::string>& args) {
     if (a == "--help" || a == "-h") {
       std::fputs(kWorstCaseHelp, stdout);
       return 0;
-    } else if (a == "--list") list = true;
-    else if (a == "--search") name = value();
-    else if (a == "--seconds") seconds = parse_double(a, value(), 0, 1e9);
-    else if (a == "--threads") threads = int(parse_u64(a, value(), 1, 1024));
-    else if (a == "--seed") seed = parse_u64(a, value(), 0, UINT64_MAX);
-    else if (a == "--checkpoint") checkpoint = value();
-    else if (a == "--checkpoint-every") checkpoint_every = parse_double(a, value(), 0.1, 1e9);
-    else if (a == "--progress") progress = parse_double(a, value(), 0, 1e9);
-    else if (a == "--json") json = value();
-    else if (a == "--evaluate") evaluate = value();
+    } else if (a == "--list")
+      list = true;
+    else if (a == "--search")
+      name = value();
+    else if (a == "--seconds")
+      seconds = parse_double(a, value(), 0, 1e9);
+    else if (a == "--threads")
+      threads = int(parse_u64(a, value(), 1, 1024));
+    else if (a == "--seed")
+      seed = parse_u64(a, value(), 0, UINT64_MAX);
+    else if (a == "--checkpoint")
+      checkpoint = value();
+    else if (a == "--checkpoint-every")
+      checkpoint_every = parse_double(a, value(), 0.1, 1e9);
+    else if (a == "--progress")
+      progress = parse_double(a, value(), 0, 1e9);
+    else if (a == "--json")
+      json = value();
+    else if (a == "--evaluate")
+      evaluate = value();
     else if (a == "--shard") {
       const std::string v = value();
       const auto slash = v.find('/');
       if (slash == std::string::npos) throw UsageError("--shard needs I/N, e.g. 3/8, got '" + v + "'");
       shard_count = parse_u64("--shard N", v.substr(slash + 1), 1, UINT32_MAX);
       shard_index = parse_u64("--shard I", v.substr(0, slash), 0, shard_count - 1);
-    } else throw UsageError("unknown option '" + a + "'");
+    } else
+      throw UsageError("unknown option '" + a + "'");
   }
   if (list) {
     list_searches();
@@ -129,8 +140,11 @@ int worst_case_main(const std::vector<std::string>& args) {
     }
     const std::optional<Search> from = find_search(r.search);
     bool same = from && from->parameters.size() == search->parameters.size();
-    for (std::size_t i = 0; same && i < search->parameters.size(); ++i) same = from->parameters[i].name == search->parameters[i].name;
-    if (!same) throw UsageError(evaluate + " holds an input of '" + r.search + "', whose parameters differ from '" + name + "'s");
+    for (std::size_t i = 0; same && i < search->parameters.size(); ++i)
+      same = from->parameters[i].name == search->parameters[i].name;
+    if (!same)
+      throw UsageError(evaluate + " holds an input of '" + r.search + "', whose parameters differ from '" + name +
+                       "'s");
     if (r.best_x.empty()) throw UsageError(evaluate + " holds no input");
     const long double value = search->objective(r.best_x);
     std::printf("%s at the input of %s: %.6Le\n", name.c_str(), evaluate.c_str(), value);
@@ -154,7 +168,8 @@ int worst_case_main(const std::vector<std::string>& args) {
       std::fprintf(stderr, "warpcheck worst-case: checkpoint %s: %s\n", checkpoint.c_str(), e.what());
       return 1;
     }
-    if (state.search != name || state.seed != seed || state.shard_index != shard_index || state.shard_count != shard_count)
+    if (state.search != name || state.seed != seed || state.shard_index != shard_index ||
+        state.shard_count != shard_count)
       throw UsageError("checkpoint " + checkpoint + " belongs to search '" + state.search + "' seed " +
                        std::to_string(state.seed) + " shard " + std::to_string(state.shard_index) + "/" +
                        std::to_string(state.shard_count) + ", not to this command");
@@ -193,8 +208,10 @@ int worst_case_main(const std::vector<std::string>& args) {
     run_search(*search, state, o);
     const std::string text = to_json(state, &*search);
     if (!checkpoint.empty()) write_file_atomically(checkpoint, text);
-    if (json.empty()) std::fputs(text.c_str(), stdout);
-    else write_file_atomically(json, text);
+    if (json.empty())
+      std::fputs(text.c_str(), stdout);
+    else
+      write_file_atomically(json, text);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "warpcheck worst-case: %s\n", e.what());
     return 1;
@@ -233,8 +250,10 @@ int merge_main(const std::vector<std::string>& args) {
     m.command = joined("warpcheck merge", args);
     const std::optional<Search> s = find_search(m.search);
     const std::string text = to_json(m, s ? &*s : nullptr);
-    if (json.empty()) std::fputs(text.c_str(), stdout);
-    else write_file_atomically(json, text);
+    if (json.empty())
+      std::fputs(text.c_str(), stdout);
+    else
+      write_file_atomically(json, text);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "warpcheck merge: %s\n", e.what());
     return 1;

@@ -47,8 +47,8 @@ void cap_coordinates(const Cap<Real>& cap, const Vec3L& w, Real& t, Real& phi) {
 // bisects every panel down to max_depth, 2^depth panels. This driver instead always splits the panel with the
 // largest error estimate and stops at the tolerance or at the budget, whichever comes first, and reports the
 // error estimate it reached, so a caller can see when the budget, not the tolerance, ended the work.
-QuadratureResult integrate_adaptive(const std::function<Real(Real)>& f, Real a, Real b, Real rel_tol,
-                                    Real abs_tol, int max_panels, int initial_panels) {
+QuadratureResult integrate_adaptive(const std::function<Real(Real)>& f, Real a, Real b, Real rel_tol, Real abs_tol,
+                                    int max_panels, int initial_panels) {
   using GK = boost::math::quadrature::gauss_kronrod<Real, 15>;
   struct Panel {
     Real a, b, value, error;
@@ -75,10 +75,14 @@ QuadratureResult integrate_adaptive(const std::function<Real(Real)>& f, Real a, 
     Real f_lo_outer = 0, f_lo_inner = 0, f_hi_outer = 0, f_hi_inner = 0;
     auto recording = [&](Real t) {
       const Real v = f(t);
-      if (t == c - h * outer) f_lo_outer = v;
-      else if (t == c - h * inner) f_lo_inner = v;
-      else if (t == c + h * outer) f_hi_outer = v;
-      else if (t == c + h * inner) f_hi_inner = v;
+      if (t == c - h * outer)
+        f_lo_outer = v;
+      else if (t == c - h * inner)
+        f_lo_inner = v;
+      else if (t == c + h * outer)
+        f_hi_outer = v;
+      else if (t == c + h * inner)
+        f_hi_inner = v;
       return v;
     };
     // Boost maps a finite [lo, hi] to [-1, 1] as t = c + h x, the arithmetic repeated above.
@@ -107,11 +111,14 @@ QuadratureResult integrate_adaptive(const std::function<Real(Real)>& f, Real a, 
   Panel l, r;
   if (initial_panels > 1) {
     for (int k = 0; k < initial_panels; ++k)
-      heap.push_back(panel(a + (b - a) * k / initial_panels, k + 1 == initial_panels ? b : a + (b - a) * (k + 1) / initial_panels));
+      heap.push_back(panel(a + (b - a) * k / initial_panels,
+                           k + 1 == initial_panels ? b : a + (b - a) * (k + 1) / initial_panels));
   } else {
     const Panel root = panel(a, b);
-    if (split(root, l, r)) heap.push_back(l), heap.push_back(r);
-    else heap.push_back(root);
+    if (split(root, l, r))
+      heap.push_back(l), heap.push_back(r);
+    else
+      heap.push_back(root);
   }
   std::make_heap(heap.begin(), heap.end());
   Real value = 0, error = 0;
@@ -150,9 +157,9 @@ QuadratureResult integrate_adaptive(const std::function<Real(Real)>& f, Real a, 
 }
 
 QuadratureResult integrate_cap_region_with_error(const std::function<Real(const Vec3L&)>& f, const Cap<Real>& cap,
-                                                 Real t0, Real t1, Real phi0, Real phi1, Real tol,
-                                                 int azimuth_panels, int radial_panels,
-                                                 const std::vector<Vec3L>& boundary_planes, Real abs_tol) {
+                                                 Real t0, Real t1, Real phi0, Real phi1, Real tol, int azimuth_panels,
+                                                 int radial_panels, const std::vector<Vec3L>& boundary_planes,
+                                                 Real abs_tol) {
   // Panel budget per line: a jump needs ~35 bisections to reach 1e-10 of the line's integral; 64 leaves room
   // for two jumps, and bounds the cost of a noisy integrand at 64 * 15 evaluations per line.
   constexpr int kMaxPanels = 64;
@@ -160,7 +167,8 @@ QuadratureResult integrate_cap_region_with_error(const std::function<Real(const 
   const Real omc_cap = cap.one_minus_cos;
   // The region's integral is omc_cap * (outer integral over phi of the lines' integrals): half of abs_tol to the
   // outer rule, half to the lines, spread over the azimuth range.
-  const Real outer_abs = abs_tol / (2 * omc_cap), line_abs = abs_tol / (2 * omc_cap * std::max<Real>(phi1 - phi0, 1e-300L));
+  const Real outer_abs = abs_tol / (2 * omc_cap),
+             line_abs = abs_tol / (2 * omc_cap * std::max<Real>(phi1 - phi0, 1e-300L));
   Real inner_error = 0;  // sum over the outer rule's evaluations, weighted below only roughly: reported as is
   auto inner = [&](Real phi) {
     const Real c = std::cos(phi), s = std::sin(phi);
@@ -199,9 +207,8 @@ QuadratureResult integrate_cap_region_with_error(const std::function<Real(const 
     Real value = 0, error = 0;
     for (std::size_t i = 0; i + 1 < cuts.size(); ++i) {
       if (!(cuts[i + 1] > cuts[i])) continue;
-      const QuadratureResult r =
-          integrate_adaptive(g, cuts[i], cuts[i + 1], tol / 4, line_abs / Real(cuts.size() - 1), kMaxPanels,
-                             cuts.size() == 2 ? radial_panels : 1);
+      const QuadratureResult r = integrate_adaptive(g, cuts[i], cuts[i + 1], tol / 4, line_abs / Real(cuts.size() - 1),
+                                                    kMaxPanels, cuts.size() == 2 ? radial_panels : 1);
       value += r.value, error += r.error;
     }
     inner_error = std::max(inner_error, error);
@@ -248,20 +255,21 @@ QuadratureResult integrate_cap_region_with_error(const std::function<Real(const 
   QuadratureResult outer{0, 0};
   for (std::size_t i = 0; i + 1 < phi_cuts.size(); ++i) {
     if (!(phi_cuts[i + 1] > phi_cuts[i])) continue;
-    const QuadratureResult r = integrate_adaptive(inner, phi_cuts[i], phi_cuts[i + 1], tol,
-                                                  outer_abs / Real(phi_cuts.size() - 1), kMaxPanels,
-                                                  phi_cuts.size() == 2 ? azimuth_panels : 1);
+    const QuadratureResult r =
+        integrate_adaptive(inner, phi_cuts[i], phi_cuts[i + 1], tol, outer_abs / Real(phi_cuts.size() - 1), kMaxPanels,
+                           phi_cuts.size() == 2 ? azimuth_panels : 1);
     outer.value += r.value, outer.error += r.error;
   }
   // Error: the outer rule's estimate plus the worst inner error spread over the azimuth range.
   return {omc_cap * outer.value, omc_cap * (outer.error + inner_error * (phi1 - phi0))};
 }
 
-Real integrate_cap_region(const std::function<Real(const Vec3L&)>& f, const Cap<Real>& cap, Real t0, Real t1,
-                          Real phi0, Real phi1, Real tol, int azimuth_panels, int radial_panels,
+Real integrate_cap_region(const std::function<Real(const Vec3L&)>& f, const Cap<Real>& cap, Real t0, Real t1, Real phi0,
+                          Real phi1, Real tol, int azimuth_panels, int radial_panels,
                           const std::vector<Vec3L>& boundary_planes, Real abs_tol) {
   return integrate_cap_region_with_error(f, cap, t0, t1, phi0, phi1, tol, azimuth_panels, radial_panels,
-                                         boundary_planes, abs_tol).value;
+                                         boundary_planes, abs_tol)
+      .value;
 }
 
 namespace {
@@ -313,7 +321,7 @@ template <class F> void parallel_for(std::size_t n, int threads, F&& body) {
 }
 
 struct Draws {
-  std::vector<double> t, phi;  // cap coordinates; +inf for samples outside the cap or declined
+  std::vector<double> t, phi;         // cap coordinates; +inf for samples outside the cap or declined
   std::vector<std::uint64_t> counts;  // chi-square grid counts
   std::uint64_t outside = 0, declined = 0, non_finite = 0;
 };
@@ -378,9 +386,8 @@ std::vector<Real> bin_masses(const SamplerUnderTest& s, const BatteryOptions& o)
   std::vector<Real> mass(std::size_t(R) * A);
   parallel_for(mass.size(), thread_count(o), [&](std::size_t k) {
     const int ri = int(k / A), ai = int(k % A);
-    mass[k] = integrate_cap_region(s.pdf, s.bounding_cap, Real(ri) / R, Real(ri + 1) / R,
-                                   kTwoPi<Real> * ai / A, kTwoPi<Real> * (ai + 1) / A, o.quadrature_tolerance, 1, 1,
-                                   s.boundary_planes);
+    mass[k] = integrate_cap_region(s.pdf, s.bounding_cap, Real(ri) / R, Real(ri + 1) / R, kTwoPi<Real> * ai / A,
+                                   kTwoPi<Real> * (ai + 1) / A, o.quadrature_tolerance, 1, 1, s.boundary_planes);
   });
   return mass;
 }
@@ -410,14 +417,16 @@ TestResult chi_square(const SamplerUnderTest& s, const BatteryOptions& o, const 
     r.expected.push_back(double(e));
   }
   r.map_rows = o.radial_bins, r.map_cols = o.azimuth_bins;
-  if (expected_elsewhere < 1e-3L && observed_elsewhere > 0) impossible += observed_elsewhere;
-  else bins.emplace_back(expected_elsewhere, Real(observed_elsewhere));
+  if (expected_elsewhere < 1e-3L && observed_elsewhere > 0)
+    impossible += observed_elsewhere;
+  else
+    bins.emplace_back(expected_elsewhere, Real(observed_elsewhere));
   std::ostringstream detail;
   if (impossible > 0) {
     r.statistic = std::numeric_limits<double>::infinity();
     r.p_value = 0.0;
-    detail << impossible << " samples where the pdf puts no mass (outside " << d.outside << ", declined "
-           << d.declined << ", non-finite " << d.non_finite << ")";
+    detail << impossible << " samples where the pdf puts no mass (outside " << d.outside << ", declined " << d.declined
+           << ", non-finite " << d.non_finite << ")";
     r.detail = detail.str();
     return r;
   }
@@ -428,12 +437,16 @@ TestResult chi_square(const SamplerUnderTest& s, const BatteryOptions& o, const 
   std::size_t pooled = 0;
   std::vector<std::pair<Real, Real>> kept;
   for (const auto& b : bins) {
-    if (b.first < o.min_expected) pool_e += b.first, pool_o += b.second, ++pooled;
-    else kept.push_back(b);
+    if (b.first < o.min_expected)
+      pool_e += b.first, pool_o += b.second, ++pooled;
+    else
+      kept.push_back(b);
   }
   if (pool_e > 0 || pool_o > 0) {
-    if (pool_e >= o.min_expected || kept.empty()) kept.emplace_back(pool_e, pool_o);
-    else kept.front().first += pool_e, kept.front().second += pool_o;
+    if (pool_e >= o.min_expected || kept.empty())
+      kept.emplace_back(pool_e, pool_o);
+    else
+      kept.front().first += pool_e, kept.front().second += pool_o;
   }
   Real chi2 = 0;
   for (const auto& [e, obs] : kept)
@@ -446,8 +459,8 @@ TestResult chi_square(const SamplerUnderTest& s, const BatteryOptions& o, const 
   } else {
     boost::math::chi_squared dist(dof);
     r.p_value = double(boost::math::cdf(boost::math::complement(dist, double(chi2))));
-    detail << "dof " << dof << ", " << mass.size() << " bins (" << o.radial_bins << "x" << o.azimuth_bins
-           << "), " << pooled << " pooled";
+    detail << "dof " << dof << ", " << mass.size() << " bins (" << o.radial_bins << "x" << o.azimuth_bins << "), "
+           << pooled << " pooled";
   }
   r.detail = detail.str();
   return r;
@@ -519,8 +532,8 @@ KsCdfs ks_cdfs(const SamplerUnderTest& s, const BatteryOptions& o) {
       dr[k] = integrate_cap_region(s.pdf, cap, xr[k], xr[k + 1], 0, kTwoPi<Real>, ks_tol, o.azimuth_bins, 1,
                                    s.boundary_planes, ks_abs);
     else
-      da[k - M] = integrate_cap_region(s.pdf, cap, 0, 1, kTwoPi<Real> * xa[k - M], kTwoPi<Real> * xa[k - M + 1],
-                                       ks_tol, 1, o.radial_bins, s.boundary_planes, ks_abs);
+      da[k - M] = integrate_cap_region(s.pdf, cap, 0, 1, kTwoPi<Real> * xa[k - M], kTwoPi<Real> * xa[k - M + 1], ks_tol,
+                                       1, o.radial_bins, s.boundary_planes, ks_abs);
   });
   std::vector<Real> Fr(M + 1, 0), Fa(M + 1, 0);
   for (int k = 0; k < M; ++k) Fr[k + 1] = Fr[k] + dr[k], Fa[k + 1] = Fa[k] + da[k];
@@ -537,9 +550,8 @@ TestResult pdf_integral(const SamplerUnderTest& s, const BatteryOptions& o, cons
   TestResult r = make_result(s, "pdf-integral");
   const Real inside = std::accumulate(mass.begin(), mass.end(), Real(0));
   // The rest of the sphere: t from 1 (the cap's edge) to 2 / omc (the antipode).
-  const Real outside =
-      integrate_cap_region(s.pdf, s.bounding_cap, 1, 2 / s.bounding_cap.one_minus_cos, 0, kTwoPi<Real>,
-                           o.quadrature_tolerance, o.azimuth_bins, 1, s.boundary_planes);
+  const Real outside = integrate_cap_region(s.pdf, s.bounding_cap, 1, 2 / s.bounding_cap.one_minus_cos, 0, kTwoPi<Real>,
+                                            o.quadrature_tolerance, o.azimuth_bins, 1, s.boundary_planes);
   const Real total = inside + outside;
   r.statistic = double(std::abs(total - 1));
   r.passed = std::isfinite(r.statistic) && r.statistic <= double(s.tolerance);
@@ -568,10 +580,9 @@ Real warp_density(const std::function<Sample(Real, Real)>& warp, Real u0, Real u
 
 TestResult pdf_consistency(const SamplerUnderTest& s, const BatteryOptions& o) {
   TestResult r = make_result(s, "pdf-consistency");
-  const auto& warp = s.reference_sample ? s.reference_sample
-                                        : std::function<Sample(Real, Real)>([&](Real a, Real b) {
-                                            return s.sample(double(a), double(b));
-                                          });
+  const auto& warp = s.reference_sample ? s.reference_sample : std::function<Sample(Real, Real)>([&](Real a, Real b) {
+    return s.sample(double(a), double(b));
+  });
   std::mt19937_64 g = stream(o.seed, s, 2, 0);
   Real worst_self = 0, worst_jac = 0;
   Real worst_u[2] = {0, 0};
@@ -647,8 +658,7 @@ TestResult no_sample(const SamplerUnderTest& s, const BatteryOptions& o) {
     const Real z = 2 * Real(uniform01(g)) - 1, phi = kTwoPi<Real> * Real(uniform01(g));
     const Real rho = std::sqrt(std::max<Real>(0, 1 - z * z));
     if (s.pdf(Vec3L(rho * std::cos(phi), rho * std::sin(phi), z)) != 0) ++nonzero_pdf;
-    if (s.pdf(cap_direction(s.bounding_cap, Real(uniform01(g)), kTwoPi<Real> * Real(uniform01(g)))) != 0)
-      ++nonzero_pdf;
+    if (s.pdf(cap_direction(s.bounding_cap, Real(uniform01(g)), kTwoPi<Real> * Real(uniform01(g)))) != 0) ++nonzero_pdf;
   }
   r.statistic = double(produced + nonzero_pdf);
   r.passed = produced == 0 && nonzero_pdf == 0;
@@ -666,12 +676,14 @@ std::string fmt(double v, int prec = 4) {
 std::string json_escape(const std::string& s) {
   std::string o;
   for (char c : s) {
-    if (c == '"' || c == '\\') o += '\\', o += c;
+    if (c == '"' || c == '\\')
+      o += '\\', o += c;
     else if (static_cast<unsigned char>(c) < 0x20) {
       char buf[8];
       std::snprintf(buf, sizeof buf, "\\u%04x", c);
       o += buf;
-    } else o += c;
+    } else
+      o += c;
   }
   return o;
 }
@@ -684,7 +696,6 @@ std::string json_number(double v) {
   std::snprintf(buf, sizeof buf, "%.17g", v);
   return buf;
 }
-
 
 // Validates the options and the sampler; returns the options the battery really uses.
 BatteryOptions checked_options(const SamplerUnderTest& s, const BatteryOptions& options) {
@@ -840,8 +851,7 @@ std::string to_json(const std::vector<TestResult>& results, double alpha, Correc
   return o.str();
 }
 
-std::vector<TestResult> validate(const SamplerUnderTest& s, const BatteryOptions& options, double alpha,
-                                 Correction c) {
+std::vector<TestResult> validate(const SamplerUnderTest& s, const BatteryOptions& options, double alpha, Correction c) {
   std::vector<TestResult> r = run_battery(s, options);
   apply_correction(r, alpha, c);
   return r;

@@ -59,7 +59,8 @@ std::vector<SamplerUnderTest> negative_controls() {
   out.push_back(control(
       "pdf-1pct-high-on-tenth",
       [](double u0, double) { return u0 < 0.101 ? u0 / 1.01 : 0.1 + (u0 - 0.101) * 0.9 / 0.899; }, one));
-  out.push_back(control("wrong-cosine", [](double u0, double) { return std::pow(u0, 1.005); }, one));
+  out.push_back(control(
+      "wrong-cosine", [](double u0, double) { return std::pow(u0, 1.005); }, one));
   out.push_back(control(
       "outside-now-and-then",
       [](double u0, double u1) {
@@ -67,8 +68,9 @@ std::vector<SamplerUnderTest> negative_controls() {
         return f < 1e-5 ? 1.05 + 0.15 * u0 : u0;
       },
       one));
-  out.push_back(control("pdf-disagrees-with-warp", [](double u0, double) { return u0; },
-                        [](Real t) { return 1 + Real(0.02) * (t - Real(0.5)); }));
+  out.push_back(control(
+      "pdf-disagrees-with-warp", [](double u0, double) { return u0; },
+      [](Real t) { return 1 + Real(0.02) * (t - Real(0.5)); }));
   return out;
 }
 

@@ -14,7 +14,9 @@ namespace warpcheck::validation {
 namespace {
 
 // Bounding caps: the support's vertices (clipped where the kernel clips) as directions from the shading point.
-template <class T> Cap<T> cap_of_fan(const PolygonFanView<T>& f) { return bounding_cap_of_directions(f.p.data(), f.count); }
+template <class T> Cap<T> cap_of_fan(const PolygonFanView<T>& f) {
+  return bounding_cap_of_directions(f.p.data(), f.count);
+}
 template <class T> Cap<T> cap_of_projected(const PolygonProjectedView<T>& v) {
   std::array<Vec3<T>, kMaxClippedVertices> w;
   for (int i = 0; i < v.clipped.count; ++i) w[i] = v.to_world(v.clipped.v[i]);
@@ -31,7 +33,8 @@ std::vector<Vec3L> edge_planes(const PolygonLightGeometry<Real>& g) {
   std::vector<Vec3L> planes;
   const int n = g.light.count;
   for (int i = 0; i < n; ++i) {
-    const Vec3L e = (g.light.vertices[i] - g.shading.position).cross(g.light.vertices[(i + 1) % n] - g.shading.position);
+    const Vec3L e =
+        (g.light.vertices[i] - g.shading.position).cross(g.light.vertices[(i + 1) % n] - g.shading.position);
     if (e.norm() > 0) planes.push_back(e.normalized());
   }
   return planes;
@@ -45,7 +48,8 @@ Real angular_width(const PolygonLightGeometry<Real>& g, const std::vector<Vec3L>
   for (const Vec3L& m : edges) {
     Real far = 0;
     for (int j = 0; j < g.light.count; ++j)
-      far = std::max(far, std::asin(std::min<Real>(1, std::abs(m.dot((g.light.vertices[j] - g.shading.position).normalized())))));
+      far = std::max(
+          far, std::asin(std::min<Real>(1, std::abs(m.dot((g.light.vertices[j] - g.shading.position).normalized())))));
     width = std::min(width, far);
   }
   return width;
@@ -88,7 +92,9 @@ template <class T> struct ProjectedKernel {
   }
   using Scalar = T;
   using Geometry = PolygonLightGeometry<T>;
-  static DirectionSample<T> sample(const Geometry& g, const Vec2<T>& u) { return sample_polygon_projected_solid_angle(g, u); }
+  static DirectionSample<T> sample(const Geometry& g, const Vec2<T>& u) {
+    return sample_polygon_projected_solid_angle(g, u);
+  }
   static T pdf(const Geometry& g, const Vec3<T>& w) { return pdf_polygon_projected_solid_angle(g, w); }
   static Cap<T> bounding_cap(const Geometry& g) {
     const auto v = make_polygon_projected_view<T>(g);
@@ -108,7 +114,9 @@ template <class T> struct BiasedKernel {
   }
   using Scalar = T;
   using Geometry = PolygonLightGeometry<T>;
-  static DirectionSample<T> sample(const Geometry& g, const Vec2<T>& u) { return sample_polygon_projected_solid_angle_biased(g, u); }
+  static DirectionSample<T> sample(const Geometry& g, const Vec2<T>& u) {
+    return sample_polygon_projected_solid_angle_biased(g, u);
+  }
   static T pdf(const Geometry& g, const Vec3<T>& w) { return pdf_polygon_projected_solid_angle_biased(g, w); }
   static Cap<T> bounding_cap(const Geometry& g) { return ProjectedKernel<T>::bounding_cap(g); }
   static T normaliser(const Geometry& g) { return make_polygon_projected_view<T, true>(g).projected_solid_angle; }
@@ -125,14 +133,18 @@ template <class T, bool kClipped> struct SolidAngleKernel {
   }
   using Scalar = T;
   using Geometry = PolygonLightGeometry<T>;
-  static DirectionSample<T> sample(const Geometry& g, const Vec2<T>& u) { return sample_polygon_solid_angle(g, u, kClipped); }
+  static DirectionSample<T> sample(const Geometry& g, const Vec2<T>& u) {
+    return sample_polygon_solid_angle(g, u, kClipped);
+  }
   static T pdf(const Geometry& g, const Vec3<T>& w) { return pdf_polygon_solid_angle(g, w, kClipped); }
   static Cap<T> bounding_cap(const Geometry& g) {
     const auto f = make_polygon_fan_view(g, kClipped);
     return f.valid() ? cap_of_fan(f) : cap_of_polygon(g);
   }
   static T normaliser(const Geometry& g) { return make_polygon_solid_angle_view(g, kClipped).solid_angle; }
-  static std::vector<Real> kinks_u0(const Geometry& g) { return fan_kinks<T>(make_polygon_solid_angle_view(g, kClipped)); }
+  static std::vector<Real> kinks_u0(const Geometry& g) {
+    return fan_kinks<T>(make_polygon_solid_angle_view(g, kClipped));
+  }
 };
 template <class T> using SolidAngleUnclipped = SolidAngleKernel<T, false>;
 template <class T> using SolidAngleClipped = SolidAngleKernel<T, true>;
@@ -159,7 +171,8 @@ template <class T> struct TurkKernel {
   static std::function<Real(const Vec3L&)> cached_pdf(const PolygonLightGeometry<T>& g) {
     return [v = make_turk_area_view(g)](const Vec3L& wl) {
       const Vec3<T> w = wl.template cast<T>();
-      return Real((v.valid() && all_finite(w) && in_fan_cone(v.fan, w) ? turk_density(v, Vec3<T>(w.normalized())) : T(0)));
+      return Real(
+          (v.valid() && all_finite(w) && in_fan_cone(v.fan, w) ? turk_density(v, Vec3<T>(w.normalized())) : T(0)));
     };
   }
   using Scalar = T;
@@ -222,21 +235,33 @@ const Vec3L kUp(0, 0, 1), kX(1, 0, 0), kY(0, 1, 0), kZ(0, 0, 1), kO(0, 0, 0);
 std::vector<PolygonConfig> configs() {
   const Vec3L tilt = Vec3L(0.3L, -0.2L, 1).normalized();
   return {
-      {"central-square", "1 x 1 square 1 above, normal towards it (central case)", geom(kO, kUp, square(Vec3L(0.1L, -0.1L, 1), kX, kY, 1)), true},
+      {"central-square", "1 x 1 square 1 above, normal towards it (central case)",
+       geom(kO, kUp, square(Vec3L(0.1L, -0.1L, 1), kX, kY, 1)), true},
       {"decentral-square", "1 x 1 square offset 1.5 sideways, 1 above, tilted normal (decentral case)",
        geom(kO, tilt, square(Vec3L(1.5L, 0.4L, 1), kX, kY, 1)), true},
       {"cornell", "ceiling light seen from a wall: two edges parallel to the normal (zenith case, Fig. 12)",
-       geom(kO, kX, PolygonLight<Real>{Vec3L(0.3L, 1, -0.2L), Vec3L(1.3L, 1, -0.2L), Vec3L(1.3L, 1, 0.2L), Vec3L(0.3L, 1, 0.2L)}), true},
-      {"straddling-horizon", "vertical 1 x 1.2 rectangle crossing the horizon", geom(kO, kUp, square(Vec3L(1, 0, 0.1L), kY, kZ, 1)), true},
-      {"far-1cm", "1 cm square light 40 m away (Fig. 7a)", geom(kO, kUp, square(Vec3L(20, 10, 32.4L), kX, kY, 0.01L)), true},
-      {"far-1mm", "1 mm square light 40 m away (Fig. 7b)", geom(kO, kUp, square(Vec3L(20, 10, 32.4L), kX, kY, 0.001L)), true},
-      {"nearly-edge-on", "square seen 0.3 degrees from its plane", geom(Vec3L(-2, 0.2L, 1.0105L), kX, square(Vec3L(0, 0, 1), kX, kY, 1)), true},
+       geom(kO, kX,
+            PolygonLight<Real>{Vec3L(0.3L, 1, -0.2L), Vec3L(1.3L, 1, -0.2L), Vec3L(1.3L, 1, 0.2L),
+                               Vec3L(0.3L, 1, 0.2L)}),
+       true},
+      {"straddling-horizon", "vertical 1 x 1.2 rectangle crossing the horizon",
+       geom(kO, kUp, square(Vec3L(1, 0, 0.1L), kY, kZ, 1)), true},
+      {"far-1cm", "1 cm square light 40 m away (Fig. 7a)", geom(kO, kUp, square(Vec3L(20, 10, 32.4L), kX, kY, 0.01L)),
+       true},
+      {"far-1mm", "1 mm square light 40 m away (Fig. 7b)", geom(kO, kUp, square(Vec3L(20, 10, 32.4L), kX, kY, 0.001L)),
+       true},
+      {"nearly-edge-on", "square seen 0.3 degrees from its plane",
+       geom(Vec3L(-2, 0.2L, 1.0105L), kX, square(Vec3L(0, 0, 1), kX, kY, 1)), true},
       {"triangle", "triangle, reversed winding, decentral",
-       geom(kO, kUp, PolygonLight<Real>{Vec3L(0.8L, 0.9L, 0.8L), Vec3L(1.3L, -0.4L, 0.5L), Vec3L(0.3L, 0.1L, 1)}), false},
+       geom(kO, kUp, PolygonLight<Real>{Vec3L(0.8L, 0.9L, 0.8L), Vec3L(1.3L, -0.4L, 0.5L), Vec3L(0.3L, 0.1L, 1)}),
+       false},
       {"pentagon", "regular pentagon, central", geom(kO, kUp, regular(5, Vec3L(0.2L, 0.1L, 0.7L), 0.6L)), false},
-      {"hexagon-reversed", "regular hexagon, reversed winding, decentral", geom(kO, tilt, regular(6, Vec3L(1.2L, 0.3L, 0.6L), 0.5L, true)), false},
-      {"octagon", "regular octagon straddling the zenith direction of a tilted normal", geom(kO, tilt, regular(8, Vec3L(0, 0, 0.8L), 0.9L)), false},
-      {"below-horizon", "square entirely below the horizon: no sample", geom(kO, kUp, square(Vec3L(0, 0, -1), kX, kY, 1)), true},
+      {"hexagon-reversed", "regular hexagon, reversed winding, decentral",
+       geom(kO, tilt, regular(6, Vec3L(1.2L, 0.3L, 0.6L), 0.5L, true)), false},
+      {"octagon", "regular octagon straddling the zenith direction of a tilted normal",
+       geom(kO, tilt, regular(8, Vec3L(0, 0, 0.8L), 0.9L)), false},
+      {"below-horizon", "square entirely below the horizon: no sample",
+       geom(kO, kUp, square(Vec3L(0, 0, -1), kX, kY, 1)), true},
   };
 }
 
@@ -268,7 +293,8 @@ const char* polygon_known_limitation(const std::string& kernel, const std::strin
   const bool angle_sum_baseline = kernel == "baseline-arvo-triangle" || kernel == "baseline-urena-rectangle";
   if (scalar == "float" && (config == "far-1cm" || config == "far-1mm") && angle_sum_baseline)
     return "as published, the baseline's solid angle (a sum of angles minus pi or 2 pi) cancels in float on the 1 cm "
-           "and 1 mm lights 40 m away (1 cm: Arvo 0, i.e. no samples, Urena -2.4e-7 for 5.3e-8 sr; 1 mm: Arvo 0, Urena 2.4e-7 "
+           "and 1 mm lights 40 m away (1 cm: Arvo 0, i.e. no samples, Urena -2.4e-7 for 5.3e-8 sr; 1 mm: Arvo 0, Urena "
+           "2.4e-7 "
            "for 5.3e-10); a baseline, not fixed";
   if (scalar == "float" && config == "nearly-edge-on" && angle_sum_baseline)
     return "as published, the baseline's solid angle (a sum of angles minus pi or 2 pi) cancels in float for a "
@@ -337,11 +363,13 @@ void add_case(Registry& r, const char* kernel, const PolygonConfig& c, Measure m
       case Measure::kArea: {
         n.what = "polygon area (shoelace in long double)";
         Vec3L a = Vec3L::Zero();
-        for (int i = 0; i < c.g.light.count; ++i) a += c.g.light.vertices[i].cross(c.g.light.vertices[(i + 1) % c.g.light.count]);
+        for (int i = 0; i < c.g.light.count; ++i)
+          a += c.g.light.vertices[i].cross(c.g.light.vertices[(i + 1) % c.g.light.count]);
         n.reference = a.norm() / 2;
         break;
       }
-      case Measure::kNone: break;
+      case Measure::kNone:
+        break;
     }
     s.normalizations.push_back(n);
     if constexpr (std::is_same_v<T, float>) {
@@ -350,7 +378,8 @@ void add_case(Registry& r, const char* kernel, const PolygonConfig& c, Measure m
       Real d = 0, size = 0;
       for (int i = 0; i < c.g.light.count; ++i) {
         d = std::max(d, (c.g.light.vertices[i] - c.g.shading.position).norm());
-        for (int j = 0; j < c.g.light.count; ++j) size = std::max(size, (c.g.light.vertices[i] - c.g.light.vertices[j]).norm());
+        for (int j = 0; j < c.g.light.count; ++j)
+          size = std::max(size, (c.g.light.vertices[i] - c.g.light.vertices[j]).norm());
       }
       s.tolerance = std::max(1e-6L, 64 * Real(std::numeric_limits<float>::epsilon()) * (1 + d / size));
       s.tolerance_note = "float input rounding: 64 eps (1 + distance / size)";

@@ -4,9 +4,9 @@
 // replaces the quintic by the exact inverse of A(X) (see lib/warpcheck/projected_cap.h). Both report the exact
 // density of the warp they implement. The reference projected solid angle is independent of the kernel: long
 // double adaptive quadrature of max(0, n.w) over the light's cap (integrate_cap_region).
+#include <algorithm>
 #include <boost/math/quadrature/gauss_kronrod.hpp>
 #include <boost/math/quadrature/tanh_sinh.hpp>
-#include <algorithm>
 #include <cmath>
 
 #include "warpcheck/projected_cap.h"
@@ -18,7 +18,9 @@ namespace warpcheck::validation {
 template <class T, CutDiskInverse M> struct ProjectedCapKernel {
   using Scalar = T;
   using Geometry = SphereLightGeometry<T>;
-  static DirectionSample<T> sample(const Geometry& g, const Vec2<T>& u) { return sample_projected_spherical_cap<T, M>(g, u); }
+  static DirectionSample<T> sample(const Geometry& g, const Vec2<T>& u) {
+    return sample_projected_spherical_cap<T, M>(g, u);
+  }
   static T pdf(const Geometry& g, const Vec3<T>& w) { return pdf_projected_spherical_cap<T, M>(g, w); }
   static Cap<T> bounding_cap(const Geometry& g) {
     const auto v = make_projected_cap_view(g);
@@ -56,8 +58,7 @@ Real cap_cosine_moment(const SphereLightGeometry<Real>& g, int power) {
   // not split off: a quadrature tolerance is relative to each piece, and a piece of width ~1e-19 whose
   // integral is rounding noise never meets it (measured: tangent-horizon recursed for minutes). Such a piece
   // holds at most 1e-15 of the integral.
-  if (kink > alpha * 1e-15L && kink < alpha * (1 - 1e-15L))
-    return integrate(Real(0), kink) + integrate(kink, alpha);
+  if (kink > alpha * 1e-15L && kink < alpha * (1 - 1e-15L)) return integrate(Real(0), kink) + integrate(kink, alpha);
   return integrate(Real(0), alpha);
 }
 
@@ -85,7 +86,8 @@ std::vector<ProjectedCapConfig> projected_cap_configs() {
       {"near-touching-case3", "Case 3, unit sphere 5e-4 from the shading point, centre below",
        geom(up, Vec3L(1.0004L, 0, -0.03L), 1)},
       {"tiny", "Case 1, radius 1e-2 at distance 5 (half-angle 2e-3 rad)", geom(up, Vec3L(3, 0, 4), 1e-2L)},
-      {"tiny-straddling", "Case 2, radius 1e-2 at distance 5 straddling the horizon", geom(up, Vec3L(5, 0, 0.004L), 1e-2L)},
+      {"tiny-straddling", "Case 2, radius 1e-2 at distance 5 straddling the horizon",
+       geom(up, Vec3L(5, 0, 0.004L), 1e-2L)},
       {"huge", "Case 2, radius 75 at distance 78 (half-angle 74 deg)", geom(up, Vec3L(0, 50, 60), 75)},
       {"case4", "Case 4: entirely below the horizon: no sample", geom(up, Vec3L(0, 1, -3), 1)},
   };
@@ -144,8 +146,7 @@ template <class T> SphereLightGeometry<T> cast(const SphereLightGeometry<Real>& 
 // 2.2e-5 off on the tiny-straddling ellipse piece). With the pieces matched to the cuts neither inverse reaches
 // a direction twice, so there are no bands of double coverage; the function keeps returning (a, b) pairs,
 // a == b for a single kink.
-template <CutDiskInverse M>
-std::vector<std::pair<Real, Real>> projected_cap_bands(const SphereLightGeometry<Real>& g) {
+template <CutDiskInverse M> std::vector<std::pair<Real, Real>> projected_cap_bands(const SphereLightGeometry<Real>& g) {
   using namespace projected_cap_detail;
   std::vector<std::pair<Real, Real>> bands;
   const ProjectedCapView<Real> p = make_projected_cap_view(g);
@@ -184,7 +185,8 @@ template <CutDiskInverse M> std::vector<Real> projected_cap_kinks(const SphereLi
 //   m1     = E[X]                     (equals the integral of cos over the sampler's support if pdf is its density)
 //   m1_in  = E[X 1(w in the light)]   (what a renderer computes: a ray outside the cap misses the light)
 //   m2     = E[X^2]
-template <class T, CutDiskInverse M> LambertianMoments projected_cap_lambertian_moments(const SphereLightGeometry<Real>& g, Real tol) {
+template <class T, CutDiskInverse M>
+LambertianMoments projected_cap_lambertian_moments(const SphereLightGeometry<Real>& g, Real tol) {
   // min_complement 1e-18: no abscissa closer than that to an end of [0, 1]. Boost's default (4 * min of long
   // double) puts u0 within ~1e-4900 of a piece's end, where it rounds onto the end itself (a sample on the
   // silhouette, declined, or on the next piece); for the exact inverse in long double on tiny-straddling that
@@ -215,7 +217,8 @@ template <class T, CutDiskInverse M> LambertianMoments projected_cap_lambertian_
               const auto s = sample_projected_spherical_cap<T, M>(p, Vec2<T>(T(u0), T(u1)));
               if (!s.valid()) return Real(0);
               const Vec3L w = to_long(s.direction);
-              if (what == 1 && (w - light.axis).squaredNorm() > 2 * light.one_minus_cos * (1 + in_slack)) return Real(0);
+              if (what == 1 && (w - light.axis).squaredNorm() > 2 * light.one_minus_cos * (1 + in_slack))
+                return Real(0);
               const Real x = std::max<Real>(0, n.dot(w)) / Real(s.pdf);
               return what == 2 ? x * x : x;
             },
@@ -231,8 +234,7 @@ template <class T, CutDiskInverse M> LambertianMoments projected_cap_lambertian_
 
 namespace {
 
-template <class T, CutDiskInverse M>
-Case make_case(const char* kernel, const ProjectedCapConfig& c) {
+template <class T, CutDiskInverse M> Case make_case(const char* kernel, const ProjectedCapConfig& c) {
   Case k;
   k.kernel = kernel;
   k.scalar = scalar_name<T>();
@@ -295,8 +297,9 @@ Case make_case(const char* kernel, const ProjectedCapConfig& c) {
     TestResult b = a;
     b.test = "lambertian-variance-solid-angle";
     b.statistic = double(var_sa / (phi * phi));
-    b.detail = "relative variance of the same estimator with sphere-solid-angle sampling (closed-form rings + "
-               "Gauss-Kronrod): Omega * integral(cos_+^2) / Phi^2 - 1";
+    b.detail =
+        "relative variance of the same estimator with sphere-solid-angle sampling (closed-form rings + "
+        "Gauss-Kronrod): Omega * integral(cos_+^2) / Phi^2 - 1";
     out.push_back(b);
     // The renderer's estimate counts only rays that hit the light: E[cos/pdf 1(w in cap)] must equal Phi. The
     // quintic's pieces overshoot (rays that miss: wasted, no bias) and can leave gaps (bias); this reports it.
@@ -323,16 +326,24 @@ template <CutDiskInverse M> void add_all(Registry& r, const char* kernel, const 
 
 }  // namespace
 
-template LambertianMoments projected_cap_lambertian_moments<float, CutDiskInverse::kQuintic>(const SphereLightGeometry<Real>&, Real);
-template LambertianMoments projected_cap_lambertian_moments<double, CutDiskInverse::kQuintic>(const SphereLightGeometry<Real>&, Real);
-template LambertianMoments projected_cap_lambertian_moments<Real, CutDiskInverse::kQuintic>(const SphereLightGeometry<Real>&, Real);
-template LambertianMoments projected_cap_lambertian_moments<float, CutDiskInverse::kExact>(const SphereLightGeometry<Real>&, Real);
-template LambertianMoments projected_cap_lambertian_moments<double, CutDiskInverse::kExact>(const SphereLightGeometry<Real>&, Real);
-template LambertianMoments projected_cap_lambertian_moments<Real, CutDiskInverse::kExact>(const SphereLightGeometry<Real>&, Real);
+template LambertianMoments projected_cap_lambertian_moments<float, CutDiskInverse::kQuintic>(
+    const SphereLightGeometry<Real>&, Real);
+template LambertianMoments projected_cap_lambertian_moments<double, CutDiskInverse::kQuintic>(
+    const SphereLightGeometry<Real>&, Real);
+template LambertianMoments projected_cap_lambertian_moments<Real, CutDiskInverse::kQuintic>(
+    const SphereLightGeometry<Real>&, Real);
+template LambertianMoments projected_cap_lambertian_moments<float, CutDiskInverse::kExact>(
+    const SphereLightGeometry<Real>&, Real);
+template LambertianMoments projected_cap_lambertian_moments<double, CutDiskInverse::kExact>(
+    const SphereLightGeometry<Real>&, Real);
+template LambertianMoments projected_cap_lambertian_moments<Real, CutDiskInverse::kExact>(
+    const SphereLightGeometry<Real>&, Real);
 template std::vector<Real> projected_cap_kinks<CutDiskInverse::kQuintic>(const SphereLightGeometry<Real>&);
 template std::vector<Real> projected_cap_kinks<CutDiskInverse::kExact>(const SphereLightGeometry<Real>&);
-template std::vector<std::pair<Real, Real>> projected_cap_bands<CutDiskInverse::kQuintic>(const SphereLightGeometry<Real>&);
-template std::vector<std::pair<Real, Real>> projected_cap_bands<CutDiskInverse::kExact>(const SphereLightGeometry<Real>&);
+template std::vector<std::pair<Real, Real>> projected_cap_bands<CutDiskInverse::kQuintic>(
+    const SphereLightGeometry<Real>&);
+template std::vector<std::pair<Real, Real>> projected_cap_bands<CutDiskInverse::kExact>(
+    const SphereLightGeometry<Real>&);
 
 void register_projected_cap_kernels(Registry& r) {
   for (const ProjectedCapConfig& c : projected_cap_configs()) {

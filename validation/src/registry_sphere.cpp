@@ -52,14 +52,18 @@ Real reference_visible_area(const SphereLightGeometry<Real>& g) {
 const SphereConfig kConfigs[] = {
     {"near", "unit sphere 1.65 away, half-angle 37 deg, tilted normal",
      geom(Vec3L(0, 0, 0), Vec3L(0.2L, -0.1L, 1), Vec3L(0.3L, 0.2L, 1.6L), 1)},
-    {"far", "radius 0.5 at distance 50 (half-angle 0.57 deg)", geom(Vec3L(1, 1, 0), Vec3L(0, 0, 1), Vec3L(4, -3, 50), 0.5L)},
-    {"grazing", "centre 6.8 deg above the horizon, half-angle 5.7 deg", geom(Vec3L(0, 0, 0), Vec3L(0, 0, 1), Vec3L(10, 0, 1.2L), 1)},
-    {"tiny", "radius 1e-2 at distance 5 (half-angle 2e-3 rad)", geom(Vec3L(0, 0, 0), Vec3L(0, 0, 1), Vec3L(3, 0, 4), 1e-2L)},
+    {"far", "radius 0.5 at distance 50 (half-angle 0.57 deg)",
+     geom(Vec3L(1, 1, 0), Vec3L(0, 0, 1), Vec3L(4, -3, 50), 0.5L)},
+    {"grazing", "centre 6.8 deg above the horizon, half-angle 5.7 deg",
+     geom(Vec3L(0, 0, 0), Vec3L(0, 0, 1), Vec3L(10, 0, 1.2L), 1)},
+    {"tiny", "radius 1e-2 at distance 5 (half-angle 2e-3 rad)",
+     geom(Vec3L(0, 0, 0), Vec3L(0, 0, 1), Vec3L(3, 0, 4), 1e-2L)},
     {"near-touching", "unit sphere 1e-3 above the shading point (half-angle 87 deg)",
      geom(Vec3L(0, 0, 0), Vec3L(0, 0, 1), Vec3L(0, 0, 1.001L), 1)},
     {"partly-below-horizon", "centre 8.5 deg above the horizon, half-angle 29 deg",
      geom(Vec3L(0, 0, 0), Vec3L(0, 0, 1), Vec3L(2, 0, 0.3L), 1)},
-    {"below-horizon", "entirely below the horizon: no sample", geom(Vec3L(0, 0, 0), Vec3L(0, 0, 1), Vec3L(0, 1, -3), 1)},
+    {"below-horizon", "entirely below the horizon: no sample",
+     geom(Vec3L(0, 0, 0), Vec3L(0, 0, 1), Vec3L(0, 1, -3), 1)},
 };
 
 // Why the float visible-area sampler fails (measured at 1e7 samples, seed 1: `warpcheck validate --kernel
@@ -75,9 +79,9 @@ const char* const kVisibleAreaFloat =
     "(disc = r^2 - |f_perp|^2 cancels), a band of mass ~sqrt(FLT_EPSILON) = 3.5e-4; measured pdf-integral 3.1e-4 "
     "(near) to 5.7e-4 (far) at 1e7 samples; see registry_sphere.cpp";
 
-template <template <class> class K, class T>
-void add_case(Registry& r, const char* kernel, const SphereConfig& c, Normalization (*norm)(const SphereConfig&),
-              const char* known_limitation = "") {
+template <template <class> class K, class T> void add_case(Registry& r, const char* kernel, const SphereConfig& c,
+                                                           Normalization (*norm)(const SphereConfig&),
+                                                           const char* known_limitation = "") {
   Case k;
   k.known_limitation = make_sphere_view(c.g).valid() ? known_limitation : "";  // no-sample cases pass
   k.kernel = kernel;

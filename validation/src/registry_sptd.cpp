@@ -65,7 +65,8 @@ std::vector<SptdConfig> sptd_configs() {
        pivot_phase_geometry<Real>(diag, -0.7L)},
       {"sptd-phase", "g-0.99", "pivot phase function, g_p = 0.99, whole sphere",
        pivot_phase_geometry<Real>(diag, 0.99L)},
-      {"sptd-phase-sphere-light", "hg-0.9", "pivot phase function fitted to HG g = 0.9 (Eq. 27), sampled jointly with a sphere light (Sec. 6.2)",
+      {"sptd-phase-sphere-light", "hg-0.9",
+       "pivot phase function fitted to HG g = 0.9 (Eq. 27), sampled jointly with a sphere light (Sec. 6.2)",
        pivot_phase_sphere_light_geometry<Real>(Vec3L(1, 0.2L, 0.4L).normalized(), hg_to_pivot(0.9L), light)},
       {"sptd-phase-sphere-light", "back-0.6", "g_p = -0.6, light behind the propagation direction",
        pivot_phase_sphere_light_geometry<Real>(Vec3L(-1, 0, -0.3L).normalized(), -0.6L, light)},
@@ -119,14 +120,16 @@ PolygonLightGeometry<Real> decentral_rectangle() {
   PolygonLightGeometry<Real> g;
   g.shading.position = Vec3L(0, 0, 0);
   g.shading.normal = Vec3L(0.1L, -0.2L, 1);
-  g.light = PolygonLight<Real>{Vec3L(0.2L, -0.6L, 1), Vec3L(1.4L, -0.6L, 1), Vec3L(1.4L, 0.2L, 1.2L), Vec3L(0.2L, 0.2L, 1.2L)};
+  g.light = PolygonLight<Real>{Vec3L(0.2L, -0.6L, 1), Vec3L(1.4L, -0.6L, 1), Vec3L(1.4L, 0.2L, 1.2L),
+                               Vec3L(0.2L, 0.2L, 1.2L)};
   return g;
 }
 PolygonLightGeometry<Real> straddling_rectangle() {  // crosses the shading horizon
   PolygonLightGeometry<Real> g;
   g.shading.position = Vec3L(0, 0, 0);
   g.shading.normal = kZ;
-  g.light = PolygonLight<Real>{Vec3L(1, -0.5L, -0.3L), Vec3L(1, 0.5L, -0.3L), Vec3L(1, 0.5L, 0.9L), Vec3L(1, -0.5L, 0.9L)};
+  g.light =
+      PolygonLight<Real>{Vec3L(1, -0.5L, -0.3L), Vec3L(1, 0.5L, -0.3L), Vec3L(1, 0.5L, 0.9L), Vec3L(1, -0.5L, 0.9L)};
   return g;
 }
 Mat3<Real> mat(Real a, Real b, Real c, Real d, Real e, Real f, Real g, Real h, Real i) {
@@ -139,15 +142,21 @@ std::vector<LtcConfig> ltc_configs() {
   // "random": drawn once from test_ltc_mis.cpp's random_m (seed 5), rounded to 4 digits.
   const Mat3<Real> random = mat(0.4115L, -0.1846L, -0.4395L, 0.0704L, 0.8373L, -0.1615L, -0.3702L, 0.0751L, 1);
   return {
-      {"identity", "M = I (projected solid angle sampling), decentral rectangle", {decentral_rectangle(), Mat3<Real>::Identity()}},
+      {"identity",
+       "M = I (projected solid angle sampling), decentral rectangle",
+       {decentral_rectangle(), Mat3<Real>::Identity()}},
       {"random", "a random LTC-like M (condition number ~3), decentral rectangle", {decentral_rectangle(), random}},
-      {"ill-conditioned", "narrow lobe tilted towards the light: |M| = 1.2e-5, condition number ~300",
+      {"ill-conditioned",
+       "narrow lobe tilted towards the light: |M| = 1.2e-5, condition number ~300",
        {decentral_rectangle(), mat(0.004L, 0, 0.5L, 0, 0.003L, -0.1L, 0, 0, 1)}},
-      {"near-singular", "|M| = 1e-8, condition number ~1e4 (a near-mirror lobe)",
+      {"near-singular",
+       "|M| = 1e-8, condition number ~1e4 (a near-mirror lobe)",
        {decentral_rectangle(), mat(1e-4L, 0, 0.6L, 0, 1e-4L, -0.15L, 0, 0, 1)}},
-      {"straddling-horizon", "rectangle crossing the horizon, sheared M: clipped in the transformed space",
+      {"straddling-horizon",
+       "rectangle crossing the horizon, sheared M: clipped in the transformed space",
        {straddling_rectangle(), mat(0.5L, 0, 0.3L, 0, 0.7L, 0, 0.2L, 0, 1)}},
-      {"lobe-away", "lobe tilted away from the light: samples also below the shading horizon",
+      {"lobe-away",
+       "lobe tilted away from the light: samples also below the shading horizon",
        {straddling_rectangle(), mat(0.3L, 0, -0.6L, 0, 0.3L, 0, 0, 0, 1)}},
   };
 }

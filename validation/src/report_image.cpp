@@ -37,19 +37,18 @@ Rgb lerp_stops(const std::vector<std::pair<double, Rgb>>& stops, double t) {
 
 Rgb sequential_color(double t) {
   // Five stops read off matplotlib's viridis (its published endpoints and quartiles); linear in between.
-  static const std::vector<std::pair<double, Rgb>> stops = {{0.0, {68, 1, 84}},
-                                                           {0.25, {59, 82, 139}},
-                                                           {0.5, {33, 145, 140}},
-                                                           {0.75, {94, 201, 98}},
-                                                           {1.0, {253, 231, 37}}};
+  static const std::vector<std::pair<double, Rgb>> stops = {
+      {0.0, {68, 1, 84}}, {0.25, {59, 82, 139}}, {0.5, {33, 145, 140}}, {0.75, {94, 201, 98}}, {1.0, {253, 231, 37}}};
   return lerp_stops(stops, t);
 }
 
 Rgb diverging_color(double t) {
   // Blue (negative: fewer samples than expected) -> white -> red (more samples than expected).
-  static const std::vector<std::pair<double, Rgb>> stops = {
-      {-1.0, {33, 102, 172}}, {-0.5, {146, 197, 222}}, {0.0, {247, 247, 247}}, {0.5, {244, 165, 130}},
-      {1.0, {178, 24, 43}}};
+  static const std::vector<std::pair<double, Rgb>> stops = {{-1.0, {33, 102, 172}},
+                                                            {-0.5, {146, 197, 222}},
+                                                            {0.0, {247, 247, 247}},
+                                                            {0.5, {244, 165, 130}},
+                                                            {1.0, {178, 24, 43}}};
   return lerp_stops(stops, t);
 }
 

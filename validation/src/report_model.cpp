@@ -79,7 +79,8 @@ BatteryRun parse_battery_json(const std::string& text) {
     if (!passed.is_bool()) bad(where + ".passed is not a boolean");
     x.passed = passed.get_bool();
     if (const auto* d = r.if_contains("detail")) x.detail = string_of(*d, where + ".detail");
-    if (const auto* k = r.if_contains("known_limitation")) x.known_limitation = string_of(*k, where + ".known_limitation");
+    if (const auto* k = r.if_contains("known_limitation"))
+      x.known_limitation = string_of(*k, where + ".known_limitation");
     if (const auto* m = r.if_contains("map")) {
       if (!m->is_object()) bad(where + ".map is not an object");
       const json::object& mo = m->get_object();

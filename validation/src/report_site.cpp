@@ -24,12 +24,23 @@ std::string html_escape(const std::string& s) {
   std::string o;
   o.reserve(s.size());
   for (char c : s) switch (c) {
-      case '&': o += "&amp;"; break;
-      case '<': o += "&lt;"; break;
-      case '>': o += "&gt;"; break;
-      case '"': o += "&quot;"; break;
-      case '\'': o += "&#39;"; break;
-      default: o += c;
+      case '&':
+        o += "&amp;";
+        break;
+      case '<':
+        o += "&lt;";
+        break;
+      case '>':
+        o += "&gt;";
+        break;
+      case '"':
+        o += "&quot;";
+        break;
+      case '\'':
+        o += "&#39;";
+        break;
+      default:
+        o += c;
     }
   return o;
 }
@@ -174,9 +185,10 @@ std::string marginal_bars_svg(const std::vector<double>& res, const std::string&
     const double v = std::isfinite(res[i]) ? res[i] : (res[i] > 0 ? m : -m);
     const double h = std::abs(v) / m * (B - T) / 2;
     const Rgb c = diverging_color(v / m);
-    o << "<rect x=\"" << L + bw * i + 0.5 << "\" y=\"" << (v > 0 ? mid - h : mid) << "\" width=\"" << std::max(bw - 1, 0.5)
-      << "\" height=\"" << h << "\" fill=\"rgb(" << int(c[0]) << "," << int(c[1]) << "," << int(c[2])
-      << ")\" stroke=\"" << (std::abs(v) > 3 ? "#000" : "none") << "\"><title>" << i << ": " << num(res[i]) << "</title></rect>";
+    o << "<rect x=\"" << L + bw * i + 0.5 << "\" y=\"" << (v > 0 ? mid - h : mid) << "\" width=\""
+      << std::max(bw - 1, 0.5) << "\" height=\"" << h << "\" fill=\"rgb(" << int(c[0]) << "," << int(c[1]) << ","
+      << int(c[2]) << ")\" stroke=\"" << (std::abs(v) > 3 ? "#000" : "none") << "\"><title>" << i << ": " << num(res[i])
+      << "</title></rect>";
   }
   o << "</svg>";
   return o.str();
@@ -192,8 +204,10 @@ std::string chi2_maps(const Result& r, std::optional<long long> samples, const f
   for (std::size_t i = 0; i < n; ++i) {
     const double o = r.observed[i], e = r.expected[i];
     vlo = std::min({vlo, o, e}), vhi = std::max({vhi, o, e});
-    if (e > 0) res[i] = (o - e) / std::sqrt(e);
-    else res[i] = o > 0 ? std::numeric_limits<double>::infinity() : 0, zero_mass_hits += o > 0;
+    if (e > 0)
+      res[i] = (o - e) / std::sqrt(e);
+    else
+      res[i] = o > 0 ? std::numeric_limits<double>::infinity() : 0, zero_mass_hits += o > 0;
     if (std::abs(res[i]) > std::abs(res[worst])) worst = i;
     if (std::isfinite(res[i])) rmax = std::max(rmax, std::abs(res[i]));
   }
@@ -213,8 +227,8 @@ std::string chi2_maps(const Result& r, std::optional<long long> samples, const f
   }
   // Residual scale: at least +-4 so that noise (|r| ~ 1) stays pale and a failure saturates.
   const double scale = std::max(4.0, rmax);
-  const std::string base = "img/" + safe_name(r.kernel) + "__" + safe_name(r.scalar) + "__" + safe_name(r.config) +
-                           "__" + safe_name(r.test);
+  const std::string base =
+      "img/" + safe_name(r.kernel) + "__" + safe_name(r.scalar) + "__" + safe_name(r.config) + "__" + safe_name(r.test);
   auto seq = [&](double v) { return sequential_color((v - vlo) / (vhi - vlo > 0 ? vhi - vlo : 1)); };
   auto div = [&](double v) { return diverging_color(std::isfinite(v) ? v / scale : v > 0 ? 1 : -1); };
   write_png((out / (base + "-observed.png")).string(), polar_map(R, A, r.observed, 256, seq));
@@ -255,17 +269,18 @@ std::string chi2_maps(const Result& r, std::optional<long long> samples, const f
       << "</figure>";
   }
   o << "<p class=\"muted\">Equal-area view of the bounding cap from above: radius sqrt(t), t = (1 - cos theta) / "
-       "(1 - cos theta_max) in " << R << " rows; azimuth phi counter-clockwise from the cap frame's x axis (right) in "
-    << A << " columns; every bin covers the same pixel area. Largest residual " << num(res[worst])
-    << " in t in [" << num(double(wr) / R) << ", " << num(double(wr + 1) / R) << "), phi/2pi in ["
-    << num(double(wa) / A) << ", " << num(double(wa + 1) / A) << ")"
+       "(1 - cos theta_max) in "
+    << R << " rows; azimuth phi counter-clockwise from the cap frame's x axis (right) in " << A
+    << " columns; every bin covers the same pixel area. Largest residual " << num(res[worst]) << " in t in ["
+    << num(double(wr) / R) << ", " << num(double(wr + 1) / R) << "), phi/2pi in [" << num(double(wa) / A) << ", "
+    << num(double(wa + 1) / A) << ")"
     << (zero_mass_hits ? "; " + std::to_string(zero_mass_hits) + " bins with samples but zero expected mass" : "")
     << (ring ? ". The ring around the residual map: samples off the grid (outside the bounding cap or declined), " +
                    num(off_o, 6) + " observed against " + num(off_e, 6) + " expected" +
                    (off_o > 0.5 && off_e == 0 ? " (impossible under the pdf: saturated red)" : "")
              : std::string(""))
-    << ". Exact values (32-bit float; the JSON has the 9-digit expected counts): <a href=\"" << base
-    << ".exr\">" << safe_name(r.test) << ".exr</a> (channels observed, expected, residual; " << A << " x " << R
+    << ". Exact values (32-bit float; the JSON has the 9-digit expected counts): <a href=\"" << base << ".exr\">"
+    << safe_name(r.test) << ".exr</a> (channels observed, expected, residual; " << A << " x " << R
     << ", row = radial bin).</p></div>\n";
   return o.str();
 }
@@ -279,8 +294,7 @@ std::string sample_sets(const std::string& kernel, const std::vector<const Case*
   for (const Case* c : cases)
     if (c->kernel == kernel) mine.push_back(c);
   if (mine.empty())
-    return "<p class=\"muted\">No registry case named " + html_escape(kernel) +
-           " in this build: no sample sets.</p>\n";
+    return "<p class=\"muted\">No registry case named " + html_escape(kernel) + " in this build: no sample sets.</p>\n";
   // Prefer configurations of this run, then double precision; one case per configuration.
   std::stable_sort(mine.begin(), mine.end(), [&](const Case* a, const Case* b) {
     const int ka = (configs_in_run.count(a->config) ? 0 : 2) + (a->scalar == "double" ? 0 : 1);
@@ -322,7 +336,8 @@ std::string json_scalar(const json::value& v) {
   return json::serialize(v);
 }
 
-void flatten(const json::value& v, const std::string& path, std::vector<std::pair<std::string, const json::value*>>& out) {
+void flatten(const json::value& v, const std::string& path,
+             std::vector<std::pair<std::string, const json::value*>>& out) {
   if (v.is_object()) {
     for (const auto& kv : v.get_object())
       flatten(kv.value(), path.empty() ? std::string(kv.key()) : path + "." + std::string(kv.key()), out);
@@ -367,7 +382,8 @@ std::string claims_table(const json::object& o) {
     }
     bool first = true;
     for (const auto& k : keys) {
-      t << "<tr>" << (first ? "<td rowspan=\"" + std::to_string(keys.size()) + "\">" + html_escape(claim) + "</td>" : "")
+      t << "<tr>"
+        << (first ? "<td rowspan=\"" + std::to_string(keys.size()) + "\">" + html_escape(claim) + "</td>" : "")
         << "<td>" << html_escape(k) << "</td><td>" << html_escape(rows[k].first.empty() ? "-" : rows[k].first)
         << "</td><td>" << html_escape(rows[k].second.empty() ? "-" : rows[k].second) << "</td></tr>";
       first = false;
@@ -421,7 +437,8 @@ std::string claims_section(const fs::path& data) {
       o << "<p class=\"notrun\">" << html_escape(err.empty() ? p.string() + " is not a JSON object" : err) << "</p>";
       return;
     }
-    o << "<p class=\"muted\">From <code>data/" << html_escape(dir) << "/claims.json</code>.</p>" << claims_table(v->get_object());
+    o << "<p class=\"muted\">From <code>data/" << html_escape(dir) << "/claims.json</code>.</p>"
+      << claims_table(v->get_object());
   };
   for (const auto& f : fams) one(f.dir, f.title, f.command);
   if (fs::exists(data)) {  // any other family that writes claims
@@ -504,13 +521,16 @@ std::string fuzz_section(const fs::path& data) {
   std::ostringstream o;
   o << "<h2 id=\"fuzz\">Fuzz campaigns</h2>\n";
   const fs::path p = data / "fuzz" / "summary.json";
-  if (!fs::exists(p)) return o.str() + not_run("data/fuzz/summary.json does not exist", "fuzz/campaign.sh --minutes 10 --jobs 1");
+  if (!fs::exists(p))
+    return o.str() + not_run("data/fuzz/summary.json does not exist", "fuzz/campaign.sh --minutes 10 --jobs 1");
   std::string err;
   const auto v = load_json(p, err);
   if (!v || !v->is_object() || !v->get_object().if_contains("targets") || !v->get_object().at("targets").is_object())
-    return o.str() + "<p class=\"notrun\">" + html_escape(err.empty() ? "data/fuzz/summary.json has no \"targets\" object" : err) + "</p>";
+    return o.str() + "<p class=\"notrun\">" +
+           html_escape(err.empty() ? "data/fuzz/summary.json has no \"targets\" object" : err) + "</p>";
   const auto& root = v->get_object();
-  if (root.if_contains("description")) o << "<p class=\"muted\">" << html_escape(json_scalar(root.at("description"))) << "</p>";
+  if (root.if_contains("description"))
+    o << "<p class=\"muted\">" << html_escape(json_scalar(root.at("description"))) << "</p>";
   o << "<table><tr><th>target</th><th>date</th><th>minutes</th><th>executions</th><th>exec/s</th><th>cov</th>"
        "<th>ft</th><th>corpus before / after</th><th>findings</th><th>command</th></tr>";
   for (const auto& kv : root.at("targets").get_object()) {
@@ -527,9 +547,9 @@ std::string fuzz_section(const fs::path& data) {
     }
     o << "<tr><td>" << html_escape(std::string(kv.key())) << "</td><td>" << html_escape(get("date")) << "</td><td>"
       << html_escape(get("minutes")) << "</td><td>" << html_escape(get("executions")) << "</td><td>"
-      << html_escape(get("exec_per_s")) << "</td><td>" << html_escape(get("cov")) << "</td><td>" << html_escape(get("ft"))
-      << "</td><td>" << html_escape(get("corpus_files_before")) << " / " << html_escape(get("corpus_files_after"))
-      << "</td><td" << (nfind ? " class=\"known\"" : "") << ">" << nfind
+      << html_escape(get("exec_per_s")) << "</td><td>" << html_escape(get("cov")) << "</td><td>"
+      << html_escape(get("ft")) << "</td><td>" << html_escape(get("corpus_files_before")) << " / "
+      << html_escape(get("corpus_files_after")) << "</td><td" << (nfind ? " class=\"known\"" : "") << ">" << nfind
       << (finds.empty() ? "" : "<details><summary>signatures</summary><ul>" + finds + "</ul></details>")
       << "</td><td><code>" << html_escape(get("command")) << "</code></td></tr>";
   }
@@ -607,16 +627,20 @@ std::string polygon_backward_error_map(int iterations, int cases) {
     const double l = p.err > 0 ? std::log10(p.err) : lo;
     worst = std::max(worst, p.err);
     const Rgb c = sequential_color((std::clamp(l, lo, hi) - lo) / (hi - lo));
-    o << "<circle cx=\"" << L + p.angle / 180 * (R - L) << "\" cy=\"" << B - p.xi * (B - T) << "\" r=\"1.8\" fill=\"rgb("
-      << int(c[0]) << "," << int(c[1]) << "," << int(c[2]) << ")\"/>";
+    o << "<circle cx=\"" << L + p.angle / 180 * (R - L) << "\" cy=\"" << B - p.xi * (B - T)
+      << "\" r=\"1.8\" fill=\"rgb(" << int(c[0]) << "," << int(c[1]) << "," << int(c[2]) << ")\"/>";
   }
   for (int k = 0; k <= 4; ++k)
     o << "<text x=\"" << L + (R - L) * k / 4 << "\" y=\"" << B + 13 << "\" font-size=\"10\" text-anchor=\"middle\">"
       << 45 * k << "</text><text x=\"" << L - 4 << "\" y=\"" << B - (B - T) * k / 4 + 3
       << "\" font-size=\"10\" text-anchor=\"end\">" << k / 4.0 << "</text>";
-  o << "<text x=\"" << (L + R) / 2 << "\" y=\"" << H - 6 << "\" font-size=\"11\" text-anchor=\"middle\">sector "
-       "opening angle (degrees)</text><text x=\"12\" y=\"" << (T + B) / 2 << "\" font-size=\"11\" "
-       "text-anchor=\"middle\" transform=\"rotate(-90 12 " << (T + B) / 2 << ")\">xi (target / sector area)</text>";
+  o << "<text x=\"" << (L + R) / 2 << "\" y=\"" << H - 6
+    << "\" font-size=\"11\" text-anchor=\"middle\">sector "
+       "opening angle (degrees)</text><text x=\"12\" y=\""
+    << (T + B) / 2
+    << "\" font-size=\"11\" "
+       "text-anchor=\"middle\" transform=\"rotate(-90 12 "
+    << (T + B) / 2 << ")\">xi (target / sector area)</text>";
   for (int k = 0; k <= 8; ++k) {  // colour bar
     const Rgb c = sequential_color(k / 8.0);
     o << "<rect x=\"" << R + 12 << "\" y=\"" << B - (B - T) * (k + 1) / 9.0 << "\" width=\"14\" height=\""
@@ -649,9 +673,8 @@ std::string case3_ratio_map(int nx, int ny) {
       lo_ratio = std::min(lo_ratio, ratio), hi_ratio = std::max(hi_ratio, ratio);
       // Colour by log2 of the ratio over [0, 1] (ratio 1 to 2), the bound's range for d >= 1.094 r.
       const Rgb c = sequential_color(std::clamp(std::log2(ratio), 0.0, 1.0));
-      dots << "<rect x=\"" << L + i * cw << "\" y=\"" << B - (j + 1) * ch << "\" width=\"" << cw + 0.3
-           << "\" height=\"" << ch + 0.3 << "\" fill=\"rgb(" << int(c[0]) << "," << int(c[1]) << "," << int(c[2])
-           << ")\"/>";
+      dots << "<rect x=\"" << L + i * cw << "\" y=\"" << B - (j + 1) * ch << "\" width=\"" << cw + 0.3 << "\" height=\""
+           << ch + 0.3 << "\" fill=\"rgb(" << int(c[0]) << "," << int(c[1]) << "," << int(c[2]) << ")\"/>";
     }
   std::ostringstream o;
   o << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << W << "\" height=\"" << H << "\" role=\"img\"><title>"
@@ -664,9 +687,13 @@ std::string case3_ratio_map(int nx, int ny) {
   for (int k = 0; k <= 4; ++k)
     o << "<text x=\"" << L - 4 << "\" y=\"" << B - (B - T) * k / 4 + 3 << "\" font-size=\"10\" text-anchor=\"end\">"
       << k / 4.0 << "</text>";
-  o << "<text x=\"" << (L + R) / 2 << "\" y=\"" << H - 6 << "\" font-size=\"11\" text-anchor=\"middle\">distance / "
-       "radius</text><text x=\"12\" y=\"" << (T + B) / 2 << "\" font-size=\"11\" text-anchor=\"middle\" "
-       "transform=\"rotate(-90 12 " << (T + B) / 2 << ")\">depth of the centre / r_y</text>";
+  o << "<text x=\"" << (L + R) / 2 << "\" y=\"" << H - 6
+    << "\" font-size=\"11\" text-anchor=\"middle\">distance / "
+       "radius</text><text x=\"12\" y=\""
+    << (T + B) / 2
+    << "\" font-size=\"11\" text-anchor=\"middle\" "
+       "transform=\"rotate(-90 12 "
+    << (T + B) / 2 << ")\">depth of the centre / r_y</text>";
   for (int k = 0; k <= 8; ++k) {  // colour bar
     const Rgb c = sequential_color(k / 8.0);
     o << "<rect x=\"" << R + 12 << "\" y=\"" << B - (B - T) * (k + 1) / 9.0 << "\" width=\"14\" height=\""
@@ -718,8 +745,8 @@ ReportSummary write_report(const ReportOptions& opt) {
   for (const std::string& k : kernels) {
     const auto& rs = by_kernel[k];
     std::ostringstream p;
-    p << page_start("warpcheck: " + k) << "<p><a href=\"index.html\">&larr; all kernels</a></p><h1>"
-      << html_escape(k) << "</h1>\n";
+    p << page_start("warpcheck: " + k) << "<p><a href=\"index.html\">&larr; all kernels</a></p><h1>" << html_escape(k)
+      << "</h1>\n";
     std::size_t kf = 0;
     for (const Result* r : rs) kf += r->failed();
     p << "<div class=\"banner " << (kf ? "bad" : "good") << "\">"
@@ -742,7 +769,8 @@ ReportSummary write_report(const ReportOptions& opt) {
     std::vector<const Result*> maps;
     for (const Result* r : rs)
       if (r->map_rows > 0) maps.push_back(r);
-    std::stable_sort(maps.begin(), maps.end(), [](const Result* a, const Result* b) { return a->failed() > b->failed(); });
+    std::stable_sort(maps.begin(), maps.end(),
+                     [](const Result* a, const Result* b) { return a->failed() > b->failed(); });
     for (const Result* r : maps) p << chi2_maps(*r, run.samples, out, sum), any_map = true;
     if (!any_map)
       p << "<p class=\"muted\">No chi2 maps in these results (results written before maps were recorded, or a "
@@ -767,9 +795,9 @@ ReportSummary write_report(const ReportOptions& opt) {
     if (r.failed()) failing.push_back(&r);
   if (failing.empty())
     x << "<div class=\"banner good\">All " << run.results.size() << " tests passed"
-      << (sum.known_limitation_failures ? " (" + std::to_string(sum.known_limitation_failures) +
-                                              " failures are documented known limitations)"
-                                        : "")
+      << (sum.known_limitation_failures
+              ? " (" + std::to_string(sum.known_limitation_failures) + " failures are documented known limitations)"
+              : "")
       << ".</div>\n";
   else {
     x << "<div class=\"banner bad\" id=\"failing\">" << failing.size() << " of " << run.results.size()
@@ -777,9 +805,12 @@ ReportSummary write_report(const ReportOptions& opt) {
     for (const Result* r : failing)
       x << "<li><a href=\"" << kernel_page(r->kernel) << "#" << result_anchor(*r) << "\">" << html_escape(r->kernel)
         << " / " << html_escape(r->scalar) << " / " << html_escape(r->config) << ": " << html_escape(r->test) << "</a> "
-        << (r->p_value ? "p = " + num(*r->p_value) : "statistic " + (r->statistic ? num(*r->statistic) : std::string("null")))
+        << (r->p_value ? "p = " + num(*r->p_value)
+                       : "statistic " + (r->statistic ? num(*r->statistic) : std::string("null")))
         << " <span class=\"muted\">" << html_escape(r->detail) << "</span>"
-        << (r->map_rows ? " <a href=\"" + kernel_page(r->kernel) + "#maps-" + result_anchor(*r) + "\">(residual map)</a>" : "")
+        << (r->map_rows
+                ? " <a href=\"" + kernel_page(r->kernel) + "#maps-" + result_anchor(*r) + "\">(residual map)</a>"
+                : "")
         << "</li>";
     x << "</ul>\n";
   }
@@ -810,9 +841,11 @@ ReportSummary write_report(const ReportOptions& opt) {
           x << "<td class=\"absent\">&middot;</td>";
           continue;
         }
-        x << "<td class=\"" << cell_class(*hit) << "\" title=\"" << html_escape(verdict(*hit) + ": " + hit->detail +
-                                                                                 (hit->known_limitation.empty() ? "" : " [known limitation: " + hit->known_limitation + "]"))
-          << "\"><a href=\"" << kernel_page(k) << "#" << result_anchor(*hit) << "\">" << cell_value(*hit) << "</a></td>";
+        x << "<td class=\"" << cell_class(*hit) << "\" title=\""
+          << html_escape(verdict(*hit) + ": " + hit->detail +
+                         (hit->known_limitation.empty() ? "" : " [known limitation: " + hit->known_limitation + "]"))
+          << "\"><a href=\"" << kernel_page(k) << "#" << result_anchor(*hit) << "\">" << cell_value(*hit)
+          << "</a></td>";
       }
       x << "</tr>\n";
     }

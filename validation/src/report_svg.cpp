@@ -195,7 +195,8 @@ std::string svg_line_plot(const std::vector<Series>& series, const std::string& 
   double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
   for (const auto& s : series)
     for (const auto& [x, y] : s.points)
-      if (usable(x, y)) x0 = std::min(x0, tx(x)), x1 = std::max(x1, tx(x)), y0 = std::min(y0, ty(y)), y1 = std::max(y1, ty(y));
+      if (usable(x, y))
+        x0 = std::min(x0, tx(x)), x1 = std::max(x1, tx(x)), y0 = std::min(y0, ty(y)), y1 = std::max(y1, ty(y));
   std::ostringstream o;
   o << "<svg xmlns=\"http://www.w3.org/2000/svg\" class=\"plot\" width=\"" << width << "\" height=\"" << height
     << "\" viewBox=\"0 0 " << width << " " << height << "\" role=\"img\"><title>" << html_escape(title)
@@ -205,7 +206,8 @@ std::string svg_line_plot(const std::vector<Series>& series, const std::string& 
     return o.str();
   }
   if (x1 - x0 < 1e-12) x0 -= 0.5, x1 += 0.5;
-  if (y1 - y0 < 1e-12 * std::max(1.0, std::abs(y0))) y0 -= log_y ? 0.5 : 0.5 * std::max(std::abs(y0), 1e-300), y1 += log_y ? 0.5 : 0.5 * std::max(std::abs(y1), 1e-300);
+  if (y1 - y0 < 1e-12 * std::max(1.0, std::abs(y0)))
+    y0 -= log_y ? 0.5 : 0.5 * std::max(std::abs(y0), 1e-300), y1 += log_y ? 0.5 : 0.5 * std::max(std::abs(y1), 1e-300);
   const double L = 70, R = width - 12, T = 28, B = height - 40;
   auto X = [&](double v) { return L + (tx(v) - x0) / (x1 - x0) * (R - L); };
   auto Y = [&](double v) { return B - (ty(v) - y0) / (y1 - y0) * (B - T); };
@@ -219,8 +221,8 @@ std::string svg_line_plot(const std::vector<Series>& series, const std::string& 
     o << "<text x=\"" << f2(L + (R - L) * k / 4) << "\" y=\"" << B + 14 << "\" font-size=\"10\" text-anchor=\"middle\">"
       << buf << "</text>";
     std::snprintf(buf, sizeof buf, "%.3g", vy);
-    o << "<text x=\"" << L - 4 << "\" y=\"" << f2(B - (B - T) * k / 4 + 3)
-      << "\" font-size=\"10\" text-anchor=\"end\">" << buf << "</text>";
+    o << "<text x=\"" << L - 4 << "\" y=\"" << f2(B - (B - T) * k / 4 + 3) << "\" font-size=\"10\" text-anchor=\"end\">"
+      << buf << "</text>";
     o << "<line x1=\"" << L << "\" x2=\"" << R << "\" y1=\"" << f2(B - (B - T) * k / 4) << "\" y2=\""
       << f2(B - (B - T) * k / 4) << "\" stroke=\"#ddd\"/>";
   }
@@ -236,7 +238,8 @@ std::string svg_line_plot(const std::vector<Series>& series, const std::string& 
       if (usable(x, y)) o << f2(X(x)) << "," << f2(Y(y)) << " ";
     o << "\"/>";
     for (const auto& [x, y] : series[i].points)
-      if (usable(x, y)) o << "<circle cx=\"" << f2(X(x)) << "\" cy=\"" << f2(Y(y)) << "\" r=\"2\" fill=\"" << c << "\"/>";
+      if (usable(x, y))
+        o << "<circle cx=\"" << f2(X(x)) << "\" cy=\"" << f2(Y(y)) << "\" r=\"2\" fill=\"" << c << "\"/>";
     o << "<text x=\"" << L + 8 << "\" y=\"" << T + 14 + 13 * i << "\" font-size=\"11\" fill=\"" << c << "\">"
       << html_escape(series[i].name) << "</text>";
   }

@@ -87,9 +87,10 @@ std::optional<RandomSectorCase<L>> sector_case(std::span<const L> p, L min_area)
 Search polygon_backward_search(int k, L min_area, const char* name, const char* paper) {
   Search s;
   s.name = name;
-  s.description = "Peters 2021 Sec. 3.6: backward error |A_delta| / sector area (Eq. 7) of the decentral inversion after " +
-                  std::to_string(k) + " iteration(s), long double; sectors <= 179.999 deg, area >= " +
-                  (min_area >= 1e-3L ? std::string("1e-2") : std::string("1e-7"));
+  s.description =
+      "Peters 2021 Sec. 3.6: backward error |A_delta| / sector area (Eq. 7) of the decentral inversion after " +
+      std::to_string(k) + " iteration(s), long double; sectors <= 179.999 deg, area >= " +
+      (min_area >= 1e-3L ? std::string("1e-2") : std::string("1e-7"));
   s.paper = paper;
   s.parameters = sector_parameters();
   s.objective = [k, min_area](std::span<const L> p) -> L {
@@ -126,9 +127,12 @@ std::vector<Search> all_searches() {
   std::vector<Search> v;
   v.push_back(polygon_backward_search(0, 1e-2L, "polygon-backward-k0", "Peters 2021 Sec. 3.6: 0.27 (no iteration)"));
   v.push_back(polygon_backward_search(1, 1e-2L, "polygon-backward-k1", "not published"));
-  v.push_back(polygon_backward_search(2, 1e-2L, "polygon-backward-k2", "Peters 2021 Sec. 3.6: 1.8e-5 (two iterations, area >= 1e-2)"));
-  v.push_back(polygon_backward_search(3, 1e-2L, "polygon-backward-k3", "not published (Sec. 3.6: a third iteration for double-precision renderers)"));
-  v.push_back(polygon_backward_search(2, 1e-7L, "polygon-backward-k2-area1e-7", "Peters 2021 Sec. 3.6: 6.6e-5 (two iterations, area >= 1e-7)"));
+  v.push_back(polygon_backward_search(2, 1e-2L, "polygon-backward-k2",
+                                      "Peters 2021 Sec. 3.6: 1.8e-5 (two iterations, area >= 1e-2)"));
+  v.push_back(polygon_backward_search(3, 1e-2L, "polygon-backward-k3",
+                                      "not published (Sec. 3.6: a third iteration for double-precision renderers)"));
+  v.push_back(polygon_backward_search(2, 1e-7L, "polygon-backward-k2-area1e-7",
+                                      "Peters 2021 Sec. 3.6: 6.6e-5 (two iterations, area >= 1e-7)"));
   append_kernel_searches(v);
   append_cap_searches(v);
   return v;
@@ -213,7 +217,8 @@ SearchRecord merge_records(const std::vector<SearchRecord>& records) {
   out.history.clear();
   std::vector<HistoryPoint> all;
   for (const auto& r : records) {
-    if (r.search != out.search) throw std::runtime_error("cannot merge searches '" + out.search + "' and '" + r.search + "'");
+    if (r.search != out.search)
+      throw std::runtime_error("cannot merge searches '" + out.search + "' and '" + r.search + "'");
     all.insert(all.end(), r.history.begin(), r.history.end());
     out.evaluations += r.evaluations, out.chains += r.chains, out.seconds += r.seconds;
     out.target_seconds += r.target_seconds;
@@ -223,7 +228,8 @@ SearchRecord merge_records(const std::vector<SearchRecord>& records) {
       out.kernel_version = r.kernel_version;
     }
   }
-  std::stable_sort(all.begin(), all.end(), [](const HistoryPoint& a, const HistoryPoint& b) { return a.seconds < b.seconds; });
+  std::stable_sort(all.begin(), all.end(),
+                   [](const HistoryPoint& a, const HistoryPoint& b) { return a.seconds < b.seconds; });
   for (const HistoryPoint& h : all)
     if (out.history.empty() || better(h.best_f, out.history.back().best_f, Goal::kMaximize)) out.history.push_back(h);
   return out;
@@ -388,7 +394,8 @@ SearchRecord record_from_json(const std::string& text) {
     r.seed = u64(need("seed"));
     const auto& sh = need("shard").as_array();
     r.shard_index = u64(sh.at(0)), r.shard_count = u64(sh.at(1));
-    for (const auto& p : need("input").as_array()) r.best_x.push_back(from_hex(boost::json::value_to<std::string>(p.as_object().at("hex"))));
+    for (const auto& p : need("input").as_array())
+      r.best_x.push_back(from_hex(boost::json::value_to<std::string>(p.as_object().at("hex"))));
     r.best_f = from_hex(boost::json::value_to<std::string>(need("worst_error_hex")));
     r.best_chain = u64(need("best_chain"));
     r.evaluations = boost::json::value_to<long long>(need("evaluations"));

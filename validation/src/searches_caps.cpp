@@ -30,8 +30,9 @@ L angle_between(const Vec3<L>& a, const Vec3<L>& b) { return std::atan2(a.cross(
 Search quintic_search() {
   Search s;
   s.name = "projected-cap-quintic";
-  s.description = "Peters & Dachsbacher 2019 Sec. 3.6 (Alg. 5): |X(A) - X_quintic(A)| over A in [0, pi/2], X the exact "
-                  "inverse of A(X) = X sqrt(1 - X^2) + asin X (Boost.Math Newton), long double";
+  s.description =
+      "Peters & Dachsbacher 2019 Sec. 3.6 (Alg. 5): |X(A) - X_quintic(A)| over A in [0, pi/2], X the exact "
+      "inverse of A(X) = X sqrt(1 - X^2) + asin X (Boost.Math Newton), long double";
   s.paper = "Peters & Dachsbacher 2019 Sec. 3.6: 4.6e-5 (quintic)";
   s.parameters = {{"A", 0, kPiL / 2, "offset area A of Alg. 5 (left-area pi/2 + A)"}};
   s.objective = [](std::span<const L> p) -> L {
@@ -47,16 +48,18 @@ Search quintic_search() {
 Search case3_search() {
   Search s;
   s.name = "projected-cap-case3-ratio";
-  s.description = "Peters & Dachsbacher 2019 Sec. 3.5 (Alg. 4): p(u) / p(u') / bound, p the density per projected solid "
-                  "angle of the Case-3 warp (exact cut-disk inverse), bound = (c_x - r_x) / t_x sqrt((t_x - (c_x + r_x)) "
-                  "/ -r_x); must stay <= 1";
+  s.description =
+      "Peters & Dachsbacher 2019 Sec. 3.5 (Alg. 4): p(u) / p(u') / bound, p the density per projected solid "
+      "angle of the Case-3 warp (exact cut-disk inverse), bound = (c_x - r_x) / t_x sqrt((t_x - (c_x + r_x)) "
+      "/ -r_x); must stay <= 1";
   s.paper = "Peters & Dachsbacher 2019 Sec. 3.5: max p / min p <= bound (proved in their supplement)";
-  s.parameters = {{"log10_distance_over_radius", std::log10(1.0001L), 3, "log10(d / r), unit radius"},
-                  {"depth", 0, 1, "h = -depth * r / d: the centre's height below the horizon as a fraction of sin(theta_max)"},
-                  {"u0", 0, 1, "first sample, first coordinate"},
-                  {"u1", 0, 1, "first sample, second coordinate"},
-                  {"v0", 0, 1, "second sample, first coordinate"},
-                  {"v1", 0, 1, "second sample, second coordinate"}};
+  s.parameters = {
+      {"log10_distance_over_radius", std::log10(1.0001L), 3, "log10(d / r), unit radius"},
+      {"depth", 0, 1, "h = -depth * r / d: the centre's height below the horizon as a fraction of sin(theta_max)"},
+      {"u0", 0, 1, "first sample, first coordinate"},
+      {"u1", 0, 1, "first sample, second coordinate"},
+      {"v0", 0, 1, "second sample, first coordinate"},
+      {"v1", 0, 1, "second sample, second coordinate"}};
   s.objective = [](std::span<const L> p) -> L {
     const L d = std::pow(L(10), p[0]), h = -p[1] / d;
     SphereLightGeometry<L> g{ShadingPoint<L>{Vec3<L>::Zero(), Vec3<L>(0, 0, 1)},
@@ -84,8 +87,9 @@ Search case3_search() {
 Search sptd_invariance_search() {
   Search s;
   s.name = "sptd-cap-invariance";
-  s.description = "Dupuy, Heitz & Belcour 2017 Eqs. 2, 6-7: angle (rad) between g(w) and the boundary of g(C) for w on "
-                  "the boundary of C, long double";
+  s.description =
+      "Dupuy, Heitz & Belcour 2017 Eqs. 2, 6-7: angle (rad) between g(w) and the boundary of g(C) for w on "
+      "the boundary of C, long double";
   s.paper = "Dupuy et al. 2017: exact (the pivot transform maps caps to caps)";
   s.parameters = {{"pivot_radius", 0, 0.99L, "|r_p|"},
                   {"pivot_polar", 0, kPiL, "polar angle of r_p (rad)"},

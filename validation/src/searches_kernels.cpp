@@ -19,19 +19,19 @@
 // std::atan2, ...) instantiated on its fvar type, which they are not written for. Truncation is O(h^4), rounding
 // O(eps_L / h) = 1e-19 / h. For the pdf search we also difference with 2h and call the point unresolved (NaN)
 // when the two area elements differ by more than 1e-7 relative (the backward searches apply the same test to
-// the whole Jacobian: where it is unresolved the linearised backward error means nothing): that happens where the stencil straddles a
-// kink of the warp (a sector or fan-triangle boundary in u0) or approaches a singularity. So pdf-warp values
-// below ~1e-7 are at the resolution of the measurement, not of the kernel.
+// the whole Jacobian: where it is unresolved the linearised backward error means nothing): that happens where the
+// stencil straddles a kink of the warp (a sector or fan-triangle boundary in u0) or approaches a singularity. So
+// pdf-warp values below ~1e-7 are at the resolution of the measurement, not of the kernel.
 #include <Eigen/Dense>
 #include <cmath>
 
-#include "warpcheck/polygon_projected.h"
 #include "warpcheck/ltc.h"
-#include "warpcheck/projected_cap.h"
-#include "warpcheck/sptd.h"
+#include "warpcheck/polygon_projected.h"
 #include "warpcheck/polygon_solid_angle.h"
+#include "warpcheck/projected_cap.h"
 #include "warpcheck/sphere.h"
 #include "warpcheck/spherical_rectangle.h"
+#include "warpcheck/sptd.h"
 #include "warpcheck/validation/searches.h"
 
 namespace warpcheck::validation {
@@ -55,7 +55,8 @@ struct SphereFamily {
   }
   static Geometry<L> make(std::span<const L> p) {
     const L d = std::pow(L(10), p[0]), e = p[1] * kDeg;
-    return {ShadingPoint<L>{Vec3<L>::Zero(), Vec3<L>(0, 0, 1)}, SphereLight<L>{Vec3<L>(d * std::cos(e), 0, d * std::sin(e)), 1}};
+    return {ShadingPoint<L>{Vec3<L>::Zero(), Vec3<L>(0, 0, 1)},
+            SphereLight<L>{Vec3<L>(d * std::cos(e), 0, d * std::sin(e)), 1}};
   }
   template <class U, class T> static Geometry<U> cast(const Geometry<T>& g) {
     return {ShadingPoint<U>{g.shading.position.template cast<U>(), g.shading.normal.template cast<U>()},
@@ -148,34 +149,52 @@ LtcRectangleFamily::Geometry<L> LtcRectangleFamily::make(std::span<const L> p) {
 }
 
 template <class T> struct SphereSolidAngleK {
-  static DirectionSample<T> sample(const SphereLightGeometry<T>& g, const Vec2<T>& u) { return sample_sphere_solid_angle(g, u); }
+  static DirectionSample<T> sample(const SphereLightGeometry<T>& g, const Vec2<T>& u) {
+    return sample_sphere_solid_angle(g, u);
+  }
 };
 template <class T> struct SphereVisibleAreaK {
-  static DirectionSample<T> sample(const SphereLightGeometry<T>& g, const Vec2<T>& u) { return sample_sphere_visible_area(g, u); }
+  static DirectionSample<T> sample(const SphereLightGeometry<T>& g, const Vec2<T>& u) {
+    return sample_sphere_visible_area(g, u);
+  }
 };
 template <class T> struct ProjectedCapK {  // Peters & Dachsbacher 2019 with the paper's quintic
-  static DirectionSample<T> sample(const SphereLightGeometry<T>& g, const Vec2<T>& u) { return sample_projected_spherical_cap(g, u); }
+  static DirectionSample<T> sample(const SphereLightGeometry<T>& g, const Vec2<T>& u) {
+    return sample_projected_spherical_cap(g, u);
+  }
 };
 template <class T> struct PolygonProjectedK {  // the paper's default: two iterations
-  static DirectionSample<T> sample(const PolygonLightGeometry<T>& g, const Vec2<T>& u) { return sample_polygon_projected_solid_angle(g, u, 2); }
+  static DirectionSample<T> sample(const PolygonLightGeometry<T>& g, const Vec2<T>& u) {
+    return sample_polygon_projected_solid_angle(g, u, 2);
+  }
 };
 template <class T> struct PolygonSolidAngleK {
-  static DirectionSample<T> sample(const PolygonLightGeometry<T>& g, const Vec2<T>& u) { return sample_polygon_solid_angle(g, u, false); }
+  static DirectionSample<T> sample(const PolygonLightGeometry<T>& g, const Vec2<T>& u) {
+    return sample_polygon_solid_angle(g, u, false);
+  }
 };
 template <class T> struct ArvoK {
-  static DirectionSample<T> sample(const PolygonLightGeometry<T>& g, const Vec2<T>& u) { return sample_arvo_triangle_fan(g, u); }
+  static DirectionSample<T> sample(const PolygonLightGeometry<T>& g, const Vec2<T>& u) {
+    return sample_arvo_triangle_fan(g, u);
+  }
 };
 template <class T> struct TurkK {
-  static DirectionSample<T> sample(const PolygonLightGeometry<T>& g, const Vec2<T>& u) { return sample_turk_area(g, u); }
+  static DirectionSample<T> sample(const PolygonLightGeometry<T>& g, const Vec2<T>& u) {
+    return sample_turk_area(g, u);
+  }
 };
 template <class T> struct SptdCapK {
   static DirectionSample<T> sample(const SptdCapGeometry<T>& g, const Vec2<T>& u) { return sample_sptd_cap(g, u); }
 };
 template <class T> struct LtcPolygonK {
-  static DirectionSample<T> sample(const LtcPolygonGeometry<T>& g, const Vec2<T>& u) { return sample_ltc_polygon(g, u); }
+  static DirectionSample<T> sample(const LtcPolygonGeometry<T>& g, const Vec2<T>& u) {
+    return sample_ltc_polygon(g, u);
+  }
 };
 template <class T> struct UrenaK {
-  static DirectionSample<T> sample(const PolygonLightGeometry<T>& g, const Vec2<T>& u) { return sample_spherical_rectangle(g, u); }
+  static DirectionSample<T> sample(const PolygonLightGeometry<T>& g, const Vec2<T>& u) {
+    return sample_spherical_rectangle(g, u);
+  }
 };
 
 // ---- Measures ----------------------------------------------------------------------------------------------
@@ -203,8 +222,9 @@ template <class Warp> std::optional<Eigen::Matrix<L, 3, 2>> warp_jacobian(const 
 
 enum class Metric { kAngle, kBackward };
 
-constexpr L kBackwardStep = 1e-6L;  // with 2h the stencil reaches 4e-6: the backward searches keep u in [1e-5, 1 - 1e-5]
-constexpr L kResolved = 1e-7L;      // differences with h and 2h must agree to this (relative) to count
+constexpr L kBackwardStep =
+    1e-6L;                      // with 2h the stencil reaches 4e-6: the backward searches keep u in [1e-5, 1 - 1e-5]
+constexpr L kResolved = 1e-7L;  // differences with h and 2h must agree to this (relative) to count
 
 template <class Family, template <class> class K, class T> L precision_error(std::span<const L> p, Metric metric) {
   const std::size_t n = Family::parameters().size();
@@ -259,10 +279,12 @@ void add_kernel(std::vector<Search>& v, const std::string& kernel, const std::st
     const std::string scalar = std::is_same_v<T, float> ? "float" : "double";
     s.name = "precision-" + kernel + "-" + scalar + (metric == Metric::kAngle ? "-angle" : "-backward");
     s.description = metric == Metric::kAngle
-                        ? kernel + " (" + what + ") in " + scalar + ": angle (rad) between its sample direction and the long double "
-                          "instantiation's on the same rounded input"
-                        : kernel + " (" + what + ") in " + scalar + ": backward error max(|du0|, |du1|) explaining its sample "
-                          "direction by the long double warp (first order, 4th-order differences with h = 1e-6)";
+                        ? kernel + " (" + what + ") in " + scalar +
+                              ": angle (rad) between its sample direction and the long double "
+                              "instantiation's on the same rounded input"
+                        : kernel + " (" + what + ") in " + scalar +
+                              ": backward error max(|du0|, |du1|) explaining its sample "
+                              "direction by the long double warp (first order, 4th-order differences with h = 1e-6)";
     s.paper = "";
     s.resolution_depends_on_cpu = metric == Metric::kBackward;
     s.parameters = with_u(Family::parameters(), metric == Metric::kAngle ? L(1e-6L) : L(1e-5L));
@@ -275,7 +297,8 @@ void add_kernel(std::vector<Search>& v, const std::string& kernel, const std::st
   precision.template operator()<double>(Metric::kBackward);
   Search s;
   s.name = "pdf-warp-" + kernel;
-  s.description = kernel + " (" + what + ") in long double: |returned pdf * area element of the warp - 1|, the area "
+  s.description = kernel + " (" + what +
+                  ") in long double: |returned pdf * area element of the warp - 1|, the area "
                   "element |dw/du0 x dw/du1| by 4th-order differences (h = 1e-5; points where h and 2h disagree by "
                   "> 1e-7 are skipped as kinks)";
   s.paper = "";
@@ -291,13 +314,15 @@ void append_kernel_searches(std::vector<Search>& v) {
   add_kernel<SphereFamily, SphereSolidAngleK>(v, "sphere-solid-angle", "sphere, uniform cone");
   add_kernel<SphereFamily, SphereVisibleAreaK>(v, "sphere-visible-area", "sphere, visible-cap area");
   add_kernel<SphereFamily, ProjectedCapK>(v, "sphere-projected-cap", "sphere, Peters & Dachsbacher 2019, quintic");
-  add_kernel<RectangleFamily, PolygonProjectedK>(v, "polygon-projected-solid-angle", "rectangle, Peters 2021 Sec. 3, 2 iterations");
+  add_kernel<RectangleFamily, PolygonProjectedK>(v, "polygon-projected-solid-angle",
+                                                 "rectangle, Peters 2021 Sec. 3, 2 iterations");
   add_kernel<RectangleFamily, PolygonSolidAngleK>(v, "polygon-solid-angle", "rectangle, Peters 2021 Sec. 5");
   add_kernel<RectangleFamily, ArvoK>(v, "baseline-arvo-triangle", "rectangle, Arvo 1995 fan");
   add_kernel<RectangleFamily, TurkK>(v, "baseline-turk-area", "rectangle, Turk area sampling");
   add_kernel<RectangleFamily, UrenaK>(v, "baseline-urena-rectangle", "rectangle, Urena et al. 2013");
   add_kernel<SptdCapFamily, SptdCapK>(v, "sptd-cap", "cap under a uniform SPTD, Dupuy et al. 2017");
-  add_kernel<LtcRectangleFamily, LtcPolygonK>(v, "ltc-polygon", "rectangle through an LTC, Heitz et al. 2016 + Peters 2021");
+  add_kernel<LtcRectangleFamily, LtcPolygonK>(v, "ltc-polygon",
+                                              "rectangle through an LTC, Heitz et al. 2016 + Peters 2021");
 }
 
 }  // namespace warpcheck::validation

@@ -19,7 +19,8 @@ PolygonLightGeometry<L> test_polygon() {
   PolygonLightGeometry<L> g;
   g.shading.position = Vec3L(0, 0, 0);
   g.shading.normal = Vec3L(0.1L, -0.2L, 1);
-  g.light = PolygonLight<L>{Vec3L(0.2L, -0.6L, 1), Vec3L(1.4L, -0.6L, 1), Vec3L(1.4L, 0.2L, 1.2L), Vec3L(0.2L, 0.2L, 1.2L)};
+  g.light =
+      PolygonLight<L>{Vec3L(0.2L, -0.6L, 1), Vec3L(1.4L, -0.6L, 1), Vec3L(1.4L, 0.2L, 1.2L), Vec3L(0.2L, 0.2L, 1.2L)};
   return g;
 }
 

@@ -15,8 +15,8 @@ namespace warpcheck::validation::projected_cap_test {
 inline void expect_case3_ratio_within_bound(int count) {
   const Case3RatioStats s = case3_ratio_search<long double>(count, 8, 20260501);
   EXPECT_EQ(s.configurations, count);
-  EXPECT_LE(s.worst_excess_over_rounding, 0.0) << "max ratio/bound " << s.worst_ratio_over_bound << " at d/r = "
-                                                << s.worst_d_over_r << ", depth " << s.worst_depth;
+  EXPECT_LE(s.worst_excess_over_rounding, 0.0) << "max ratio/bound " << s.worst_ratio_over_bound
+                                               << " at d/r = " << s.worst_d_over_r << ", depth " << s.worst_depth;
   EXPECT_GT(s.worst_ratio_over_bound, 1 - 1e-9);  // the grid reaches the extremes: the bound is sharp
   EXPECT_LE(s.worst_ratio_d_ge_1_094, 2.0);
   EXPECT_LE(s.worst_ratio_d_ge_2, std::sqrt(2.0));

@@ -20,7 +20,8 @@ TEST(Ltc, BatteryPassesForRandomAndIllConditionedM) {
   for (const auto& [name, m] : cases) {
     const auto s = validation::bind_ltc<double>("polygon-ltc", name, LtcPolygonGeometry<L>{pg, m});
     ASSERT_FALSE(s.expect_no_sample) << name;
-    for (const auto& res : validation::validate(s, o, 0.01)) EXPECT_TRUE(res.passed) << name << " " << res.test << ": " << res.detail;
+    for (const auto& res : validation::validate(s, o, 0.01))
+      EXPECT_TRUE(res.passed) << name << " " << res.test << ": " << res.detail;
   }
 }
 

@@ -2,9 +2,9 @@
 // the fast ones are in test_projected_cap.cpp.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <boost/math/distributions/kolmogorov_smirnov.hpp>
 #include <boost/math/tools/roots.hpp>
-#include <algorithm>
 #include <cmath>
 #include <random>
 #include <string>
@@ -17,7 +17,9 @@ namespace {
 
 using namespace projected_cap_test;
 
-TEST(ProjectedCapCase3, DensityRatioNeverExceedsPapersBoundOn1e6RandomConfigurations) { expect_case3_ratio_within_bound(1'000'000); }
+TEST(ProjectedCapCase3, DensityRatioNeverExceedsPapersBoundOn1e6RandomConfigurations) {
+  expect_case3_ratio_within_bound(1'000'000);
+}
 
 TEST(ProjectedCapLambertian, EstimateIsUnbiasedInCase3ForBothInverses) {
   // E[cos/pdf] over primary sample space by tanh-sinh quadrature equals the independent projected solid angle.

@@ -26,12 +26,17 @@ struct BatteryCase {
 
 TEST(SptdBattery, PassesOnPivotsIncludingNormCloseToOne) {
   const BatteryCase cases[] = {
-      {"uniform-cap", Vec3L(0.2L, 0.1L, 0.5L), SptdBase::kUniform, Vec3L(0, 0, 1), Cap<L>{Vec3L(0.3L, 0, 1).normalized(), 0.3L}},
-      {"uniform-cap-0.99", Vec3L(0, 0.6L, 0.8L) * 0.99L, SptdBase::kUniform, Vec3L(0, 0, 1), Cap<L>{Vec3L(0, 0.5L, 1).normalized(), 0.2L}},
+      {"uniform-cap", Vec3L(0.2L, 0.1L, 0.5L), SptdBase::kUniform, Vec3L(0, 0, 1),
+       Cap<L>{Vec3L(0.3L, 0, 1).normalized(), 0.3L}},
+      {"uniform-cap-0.99", Vec3L(0, 0.6L, 0.8L) * 0.99L, SptdBase::kUniform, Vec3L(0, 0, 1),
+       Cap<L>{Vec3L(0, 0.5L, 1).normalized(), 0.2L}},
       {"phase-0.95", Vec3L(1, 0, 0) * 0.95L, SptdBase::kUniform, Vec3L(0, 0, 1), Cap<L>{Vec3L(0, 0, 1), 2}},
-      {"cosine-ellipse", Vec3L(0.1L, 0, 0.4L), SptdBase::kClampedCosine, Vec3L(0, 0, -1), Cap<L>{Vec3L(0.2L, 0, 1).normalized(), 0.2L}},
-      {"cosine-crossing", Vec3L(0.5L, 0, 0.3L), SptdBase::kClampedCosine, Vec3L(0, 0, 1), Cap<L>{Vec3L(1, 0, -0.3L).normalized(), 0.6L}},
-      {"cosine-crescent", Vec3L(0.2L, 0, 0.3L), SptdBase::kClampedCosine, Vec3L(0, 0, -1), Cap<L>{Vec3L(1, 0, 0.2L).normalized(), 0.3L}},
+      {"cosine-ellipse", Vec3L(0.1L, 0, 0.4L), SptdBase::kClampedCosine, Vec3L(0, 0, -1),
+       Cap<L>{Vec3L(0.2L, 0, 1).normalized(), 0.2L}},
+      {"cosine-crossing", Vec3L(0.5L, 0, 0.3L), SptdBase::kClampedCosine, Vec3L(0, 0, 1),
+       Cap<L>{Vec3L(1, 0, -0.3L).normalized(), 0.6L}},
+      {"cosine-crescent", Vec3L(0.2L, 0, 0.3L), SptdBase::kClampedCosine, Vec3L(0, 0, -1),
+       Cap<L>{Vec3L(1, 0, 0.2L).normalized(), 0.3L}},
   };
   validation::BatteryOptions o;
   o.samples = 200'000;

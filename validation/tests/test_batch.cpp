@@ -28,7 +28,7 @@ TYPED_TEST(Batch, SphereSolidAngleBatchMatchesTheScalarKernelToAFewUlps) {
   const SphereLightGeometry<T> lights[] = {
       geometry<T>(Vec3<T>(0.1, -0.2, 0), Vec3<T>(0, 0.3, 1), Vec3<T>(1, 2, 2.5), T(0.7)),
       geometry<T>(Vec3<T>(0, 0, 0), Vec3<T>(0, 0, 1), Vec3<T>(3, 0, -0.9), T(1)),      // qz = -0.9, partly below
-      geometry<T>(Vec3<T>(0, 0, 0), Vec3<T>(0, 0, 1), Vec3<T>(0, 0, 1e4), T(1)),        // tiny cone
+      geometry<T>(Vec3<T>(0, 0, 0), Vec3<T>(0, 0, 1), Vec3<T>(0, 0, 1e4), T(1)),       // tiny cone
       geometry<T>(Vec3<T>(0, 0, 0), Vec3<T>(0, 0, 1), Vec3<T>(0, -1.001, 0.1), T(1)),  // huge cone
   };
   // 1003 samples: not a multiple of the block size or any vector width; u includes the ends 0 and 1.
@@ -42,7 +42,8 @@ TYPED_TEST(Batch, SphereSolidAngleBatchMatchesTheScalarKernelToAFewUlps) {
   for (const auto& g : lights) {
     const SphereView<T> v = make_sphere_view(g);
     ASSERT_TRUE(v.valid());
-    ASSERT_EQ(sample_sphere_solid_angle_batch(v, u0.data(), u1.data(), n, DirectionBatch<T>{x.data(), y.data(), z.data(), pdf.data()}),
+    ASSERT_EQ(sample_sphere_solid_angle_batch(v, u0.data(), u1.data(), n,
+                                              DirectionBatch<T>{x.data(), y.data(), z.data(), pdf.data()}),
               NoSample::kNone);
     T worst = 0;
     for (std::size_t i = 0; i < n; ++i) {

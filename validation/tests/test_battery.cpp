@@ -4,10 +4,10 @@
 
 #include <cmath>
 #include <cstdint>
-#include <vector>
 #include <cstdio>
 #include <functional>
 #include <stdexcept>
+#include <vector>
 
 #include <Eigen/LU>
 
@@ -99,7 +99,8 @@ TEST(BinQuadrature, ANarrowLobeOnRadialLinesIsFoundWithOnePanelPerRing) {
   const Real t_lobe = Real(0.3), phi_lobe = 1;
   const Real theta = std::acos(1 - t_lobe * kBounding.one_minus_cos);
   Eigen::Matrix<Real, 3, 3> m;
-  m << Real(1e-4), 0, std::tan(theta) * std::cos(phi_lobe), 0, Real(1e-4), std::tan(theta) * std::sin(phi_lobe), 0, 0, 1;
+  m << Real(1e-4), 0, std::tan(theta) * std::cos(phi_lobe), 0, Real(1e-4), std::tan(theta) * std::sin(phi_lobe), 0, 0,
+      1;
   const Eigen::Matrix<Real, 3, 3> mi = m.inverse();
   const Real det_inv = 1 / m.determinant();
   auto ltc = [&](const Vec3L& w) -> Real {
@@ -131,14 +132,17 @@ TEST(BinQuadrature, ANarrowLobeOnRadialLinesIsFoundWithOnePanelPerRing) {
 // area (measured 5e-17: each piece's integrand is constant; required 1e-7, a tenth of the pdf-integral tolerance).
 TEST(BinQuadrature, ASliversAcuteCornersKeepTheirMassWhenTheEdgesAreGivenAsBoundaryPlanes) {
   const Cap<Real> cap{Vec3L(0, 0, 1), Real(0.05)};  // theta_max = 0.317 rad
-  auto dir = [](Real theta, Real phi) { return Vec3L(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)); };
+  auto dir = [](Real theta, Real phi) {
+    return Vec3L(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta));
+  };
   const Vec3L a = dir(Real(0.3), Real(0.1)), b = dir(Real(0.3), Real(2.6));
   const Vec3L ab = a.cross(b).normalized();
   const Vec3L c = ((a + b).normalized() + Real(3e-3) * ab).normalized();
   std::vector<Vec3L> planes{a.cross(b).normalized(), b.cross(c).normalized(), c.cross(a).normalized()};
   const Real orient = planes[0].dot(c) > 0 ? 1 : -1;
   auto sliver = [&](const Vec3L& w) {
-    for (const Vec3L& m : planes) if (orient * m.dot(w) < 0) return Real(0);
+    for (const Vec3L& m : planes)
+      if (orient * m.dot(w) < 0) return Real(0);
     return Real(1);
   };
   const Real exact = 2 * std::atan2(std::abs(a.dot(b.cross(c))), 1 + a.dot(b) + b.dot(c) + c.dot(a));
@@ -247,7 +251,7 @@ TEST(PdfConsistency, FailsWhenTheReferenceWarpIsTooNoisyToResolveItsAreaElement)
   const auto exact = s.sample;
   s.reference_sample = [exact](Real u0, Real u1) {
     Sample x = exact(double(u0), double(u1));
-    const std::uint64_t bits = std::hash<long double>{}(u0) * 31 + std::hash<long double>{}(u1);
+    const std::uint64_t bits = std::hash<long double>{}(u0)*31 + std::hash<long double>{}(u1);
     const Real noise = 1e-10L * (Real(bits % 1000003) / 1000003 - 0.5L);
     x.direction = (x.direction + Vec3L(noise, -noise, 0)).normalized();
     return x;

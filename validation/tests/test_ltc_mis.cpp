@@ -10,10 +10,10 @@
 #include <limits>
 #include <random>
 
+#include "ltc_fixtures.h"
 #include "warpcheck/mis.h"
 #include "warpcheck/validation/battery.h"
 #include "warpcheck/validation/kernels_sptd.h"
-#include "ltc_fixtures.h"
 
 namespace warpcheck {
 namespace {
@@ -53,9 +53,11 @@ TEST(Ltc, SingularOrReflectingTransformsGiveNoSample) {
   const auto pg = test_polygon().cast<double>();
   Mat3<double> m = Mat3<double>::Identity();
   m(2, 2) = 0;
-  EXPECT_EQ(sample_ltc_polygon(LtcPolygonGeometry<double>{pg, m}, Vec2<double>(0.5, 0.5)).reason, NoSample::kInvalidGeometry);
+  EXPECT_EQ(sample_ltc_polygon(LtcPolygonGeometry<double>{pg, m}, Vec2<double>(0.5, 0.5)).reason,
+            NoSample::kInvalidGeometry);
   m(2, 2) = -1;
-  EXPECT_EQ(sample_ltc_polygon(LtcPolygonGeometry<double>{pg, m}, Vec2<double>(0.5, 0.5)).reason, NoSample::kInvalidGeometry);
+  EXPECT_EQ(sample_ltc_polygon(LtcPolygonGeometry<double>{pg, m}, Vec2<double>(0.5, 0.5)).reason,
+            NoSample::kInvalidGeometry);
   m(2, 2) = std::nan("");
   EXPECT_EQ(sample_ltc_polygon(LtcPolygonGeometry<double>{pg, m}, Vec2<double>(0.5, 0.5)).reason, NoSample::kNonFinite);
   EXPECT_EQ(pdf_ltc_polygon(LtcPolygonGeometry<double>{pg, m}, Vec3<double>(0.5, 0, 1)), 0);
@@ -73,7 +75,8 @@ TEST(Ltc, SingularOrReflectingTransformsGiveNoSample) {
   const auto singular = make_ltc_polygon_view(LtcPolygonGeometry<double>{pg, s});
   EXPECT_FALSE(std::fetestexcept(FE_DIVBYZERO)) << "make_ltc_polygon_view divided by zero";
   EXPECT_EQ(singular.reason, NoSample::kInvalidGeometry);
-  EXPECT_EQ(sample_ltc_polygon(LtcPolygonGeometry<double>{pg, s}, Vec2<double>(0.5, 0.5)).reason, NoSample::kInvalidGeometry);
+  EXPECT_EQ(sample_ltc_polygon(LtcPolygonGeometry<double>{pg, s}, Vec2<double>(0.5, 0.5)).reason,
+            NoSample::kInvalidGeometry);
 }
 
 // pdf() at the sampler's own direction gives the sampler's pdf, to the rounding of the density formula (16 eps, the
@@ -104,8 +107,10 @@ TEST(Ltc, PdfEqualsTheSamplePdfForANearSingularTransform) {
 TEST(Ltc, TheInverseIsTwoSidedAndPdfMatchesTheSamplePdfForATransformOfCondition6e10) {
   LtcPolygonGeometry<double> g;
   g.polygon = PolygonLightGeometry<double>{
-      ShadingPoint<double>{{-1.9899291992187504, 0.031186217543507051, 0.034569129277040013}, {-0., 1.4142135623730949, -1.4142135623730951}},
-      PolygonLight<double>{{3.9798583984375, 0, 0}, {-1.9899291992187491, 0.43301270189221935, 0.43301270189221935},
+      ShadingPoint<double>{{-1.9899291992187504, 0.031186217543507051, 0.034569129277040013},
+                           {-0., 1.4142135623730949, -1.4142135623730951}},
+      PolygonLight<double>{{3.9798583984375, 0, 0},
+                           {-1.9899291992187491, 0.43301270189221935, 0.43301270189221935},
                            {-1.9899291992187518, -0.43301270189221919, -0.43301270189221919}}};
   g.m << 3.9999999995343387, -2, -7.1515105099495211e-62, 4, -2.0000000004656613, -7.1515105099495211e-62, 4, -2,
       -4.6566128730773926e-10;
@@ -194,16 +199,16 @@ TEST(Ltc, PdfIsPositiveAtSamplesInsideALightWithAShortEdgeOnTheHorizon) {
 // 5692ae35, issue 7).
 TEST(Ltc, ANonPlanarLightSeenFromCloseToItsPlaneIsSampledAsItsFlattening) {
   LtcPolygonGeometry<double> g;
-  g.polygon = PolygonLightGeometry<double>{
-      ShadingPoint<double>{{14.962579331135613, 3221225491.6532202, 11.826609910141354},
-                           {1, -6.9713964909789094e-18, 2.9531309136255907e-17}},
-      PolygonLight<double>{{-6, 3221225466, -1},
-                           {-11.993386006344959, 3221225468.2590613, 0.12953059442379922},
-                           {-6.6964465405750548, 3221225473.3351254, 2.667562801868943},
-                           {5.9021149417110728, 3221225477.4058132, 4.7029066037072571},
-                           {16.31532468053247, 3221225477.4058132, 4.7029066037072571},
-                           {16.701823351788715, 3221225473.3351254, 2.6675628018689439},
-                           {6.7705695728877586, 3221225468.2590613, 0.12953059442379988}}};
+  g.polygon =
+      PolygonLightGeometry<double>{ShadingPoint<double>{{14.962579331135613, 3221225491.6532202, 11.826609910141354},
+                                                        {1, -6.9713964909789094e-18, 2.9531309136255907e-17}},
+                                   PolygonLight<double>{{-6, 3221225466, -1},
+                                                        {-11.993386006344959, 3221225468.2590613, 0.12953059442379922},
+                                                        {-6.6964465405750548, 3221225473.3351254, 2.667562801868943},
+                                                        {5.9021149417110728, 3221225477.4058132, 4.7029066037072571},
+                                                        {16.31532468053247, 3221225477.4058132, 4.7029066037072571},
+                                                        {16.701823351788715, 3221225473.3351254, 2.6675628018689439},
+                                                        {6.7705695728877586, 3221225468.2590613, 0.12953059442379988}}};
   g.m = Mat3<double>::Identity();
   // The flattening in long double, onto the plane of the area vector through the centroid, with x at the origin
   // (the offsets V - x are exact; flattened world coordinates ~3.2e9 would round by 3.5e-10, 1e-3 of the height).
@@ -214,7 +219,8 @@ TEST(Ltc, ANonPlanarLightSeenFromCloseToItsPlaneIsSampledAsItsFlattening) {
   Vec3<L> c = Vec3<L>::Zero(), area = Vec3<L>::Zero();
   for (int i = 0; i < flat.light.count; ++i) c += flat.light.vertices[i] / L(flat.light.count);
   for (int i = 1; i + 1 < flat.light.count; ++i)
-    area += Vec3<L>(flat.light.vertices[i] - flat.light.vertices[0]).cross(Vec3<L>(flat.light.vertices[i + 1] - flat.light.vertices[0]));
+    area += Vec3<L>(flat.light.vertices[i] - flat.light.vertices[0])
+                .cross(Vec3<L>(flat.light.vertices[i + 1] - flat.light.vertices[0]));
   const Vec3<L> nh = area.normalized();
   L off = 0;
   for (int i = 0; i < flat.light.count; ++i) {
@@ -334,10 +340,11 @@ void expect_zero_variance(bool one_sample) {
     worst.blend = std::max(worst.blend, z.blend);
     least.balance = std::min(least.balance, z.balance), least.wrong_c = std::min(least.wrong_c, z.wrong_c);
   }
-  std::printf("[ measured ] %s: max |estimate / sum c - 1| weighted %.1e, clamped v = 1 %.1e; blend identity %.1e; "
-              "least spread of the counterparts: balance %.1e, wrong c %.1e\n",
-              one_sample ? "one-sample" : "multi-sample", worst.weighted, worst.clamped_v1, worst.blend, least.balance,
-              least.wrong_c);
+  std::printf(
+      "[ measured ] %s: max |estimate / sum c - 1| weighted %.1e, clamped v = 1 %.1e; blend identity %.1e; "
+      "least spread of the counterparts: balance %.1e, wrong c %.1e\n",
+      one_sample ? "one-sample" : "multi-sample", worst.weighted, worst.clamped_v1, worst.blend, least.balance,
+      least.wrong_c);
 }
 
 TEST(Mis, MultiSampleWeightedBalanceAndClampedOptimalHaveZeroVarianceInTheIdealisedSetting) {
@@ -361,7 +368,8 @@ PolygonLightGeometry<L> visible_part(const PolygonLightGeometry<L>& g, const Vec
     const Vec3L a = g.light.vertices[i] - g.shading.position, b = g.light.vertices[(i + 1) % m] - g.shading.position;
     const L da = a.dot(o), db = b.dot(o);
     if (da <= 0) out.light.vertices[out.light.count++] = g.shading.position + a;
-    if ((da < 0 && db > 0) || (da > 0 && db < 0)) out.light.vertices[out.light.count++] = g.shading.position + a + da / (da - db) * (b - a);
+    if ((da < 0 && db > 0) || (da > 0 && db < 0))
+      out.light.vertices[out.light.count++] = g.shading.position + a + da / (da - db) * (b - a);
   }
   return out;
 }
@@ -377,9 +385,11 @@ TEST(Mis, AllEstimatorsAreUnbiasedWithAnOccluderByAStudentTTest) {
   const Vec3L o = Vec3L(1, 0.3L, -0.8L).normalized();
   const auto pl = visible_part(test_polygon(), o);
   ASSERT_GE(pl.light.count, 3);
-  const L exact = s.emitted * (s.albedo_diffuse * validation::ltc_reference_projected_solid_angle(LtcPolygonGeometry<L>{pl, M3::Identity()}) +
-                               s.albedo_specular * validation::ltc_reference_projected_solid_angle(LtcPolygonGeometry<L>{pl, m1b})) /
-                  kPi<L>;
+  const L exact =
+      s.emitted *
+      (s.albedo_diffuse * validation::ltc_reference_projected_solid_angle(LtcPolygonGeometry<L>{pl, M3::Identity()}) +
+       s.albedo_specular * validation::ltc_reference_projected_solid_angle(LtcPolygonGeometry<L>{pl, m1b})) /
+      kPi<L>;
   ASSERT_GT(exact, 0);
   ASSERT_LT(exact, 0.95L * v.sum_c());  // the occluder matters
   auto f = [&](const Vec3<double>& w) { return w.cast<L>().dot(o) > 0 ? 0.0 : idealized_integrand(s, v, w); };
@@ -411,7 +421,8 @@ TEST(Mis, AllEstimatorsAreUnbiasedWithAnOccluderByAStudentTTest) {
     EXPECT_GT(p_one, alpha_each) << "one-sample, heuristic " << int(h);
     std::printf("[ measured ] heuristic %d: t-test p multi-sample %.3g, one-sample %.3g\n", int(h), p_multi, p_one);
   }
-  const double p_biased = t_test([&] { return 1.02 * mis_estimate_one(v, MisHeuristic::kBalance, 0.5, u(r), Vec2<double>(u(r), u(r)), f); });
+  const double p_biased = t_test(
+      [&] { return 1.02 * mis_estimate_one(v, MisHeuristic::kBalance, 0.5, u(r), Vec2<double>(u(r), u(r)), f); });
   EXPECT_LT(p_biased, alpha_each) << "the t-test cannot detect a 2% bias";
   std::printf("[ measured ] control 1.02 x one-sample balance: p %.3g (must be < %.3g)\n", p_biased, alpha_each);
   // A biased technique: the specular technique's normaliser A_Sigma(M_1^-1 P) 1% too large, so that its returned

@@ -79,7 +79,9 @@ TEST(NelderMead, RespectsTheBoxAndFindsAMinimumOnItsFace) {
 }
 
 TEST(NelderMead, MaximizesWhenAskedTo) {
-  auto f = [](std::span<const double> x) { return std::exp(-(x[0] - 0.3) * (x[0] - 0.3) - (x[1] + 0.2) * (x[1] + 0.2)); };
+  auto f = [](std::span<const double> x) {
+    return std::exp(-(x[0] - 0.3) * (x[0] - 0.3) - (x[1] + 0.2) * (x[1] + 0.2));
+  };
   NelderMeadOptions<double> o;
   o.goal = Goal::kMaximize;
   o.max_iterations = 1000;

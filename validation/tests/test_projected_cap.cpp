@@ -2,9 +2,9 @@
 // lib/warpcheck/projected_cap.h (a few seconds in all). Large counts and quadratures live in slow_projected_cap.cpp.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <boost/math/distributions/kolmogorov_smirnov.hpp>
 #include <boost/math/tools/roots.hpp>
-#include <algorithm>
 #include <cmath>
 #include <random>
 #include <string>
@@ -72,7 +72,9 @@ TEST(ProjectedCapQuintic, ExactInverseOfTheKernelAgreesWithBoostToms748InverseOf
 
 // ---- Sec. 3.5: the Case-3 density ratio bound ---------------------------------------------------------------
 
-TEST(ProjectedCapCase3, DensityRatioNeverExceedsPapersBoundOn1e4RandomConfigurations) { expect_case3_ratio_within_bound(10'000); }
+TEST(ProjectedCapCase3, DensityRatioNeverExceedsPapersBoundOn1e4RandomConfigurations) {
+  expect_case3_ratio_within_bound(10'000);
+}
 
 TEST(ProjectedCapCase3, RatioTestCatchesADensityTwoPercentAboveTheBound) {
   // Negative control: the same comparison against the bound scaled by 0.98 must report an excess.
@@ -83,7 +85,8 @@ TEST(ProjectedCapCase3, RatioTestCatchesADensityTwoPercentAboveTheBound) {
 
 TEST(ProjectedCapCase3, RatioOnAFineGridEqualsTheRatioOnTheCoarseGrid) {
   // The max/min of the density are at the cut disk's corners: refining the grid 64x changes nothing.
-  for (const auto& [h, ry] : std::vector<std::pair<double, double>>{{-0.2, 0.4}, {-0.39, 0.4}, {-0.5, 0.9}, {-0.9, 0.999}}) {
+  for (const auto& [h, ry] :
+       std::vector<std::pair<double, double>>{{-0.2, 0.4}, {-0.39, 0.4}, {-0.5, 0.9}, {-0.9, 0.999}}) {
     const auto v = make_projected_cap_view(unit_geometry<double>(h, ry));
     ASSERT_EQ(v.which_case, 3);
     EXPECT_NEAR(case3_density_ratio(v, 8), case3_density_ratio(v, 512), 1e-12) << h << " " << ry;
@@ -129,7 +132,8 @@ TEST(ProjectedCapContinuity, DirectionIsLipschitzInTheHeightAcrossTheCentreOnHor
 
 TEST(ProjectedCapLambertian, EstimateIsTheSameForEverySampleInCases1And2AndEqualsIndependentProjectedSolidAngle) {
   // With the exact inverse of A(X), cos / pdf = A_E + A_D for every sample (the paper's zero-variance claim).
-  for (const char* name : {"case1", "case1-grazing", "tangent-horizon", "case2", "centre-on-horizon", "huge", "near-touching"}) {
+  for (const char* name :
+       {"case1", "case1-grazing", "tangent-horizon", "case2", "centre-on-horizon", "huge", "near-touching"}) {
     const ProjectedCapConfig c = config(name);
     const Real phi = reference_projected_solid_angle(c.g);
     const auto v = make_projected_cap_view(c.g);
@@ -252,8 +256,9 @@ TEST(ProjectedCapQuintic, Case2PiecesMeetExactlyAtTheSeam) {
 // on the light's boundary, in every precision, and u0 -> 1 reaches the left end of the disk.
 template <class T> void expect_case3_lune_top_reached(const char* name) {
   const ProjectedCapConfig c = config(name);
-  const SphereLightGeometry<T> g{ShadingPoint<T>{c.g.shading.position.template cast<T>(), c.g.shading.normal.template cast<T>()},
-                                 SphereLight<T>{c.g.light.center.template cast<T>(), T(c.g.light.radius)}};
+  const SphereLightGeometry<T> g{
+      ShadingPoint<T>{c.g.shading.position.template cast<T>(), c.g.shading.normal.template cast<T>()},
+      SphereLight<T>{c.g.light.center.template cast<T>(), T(c.g.light.radius)}};
   const auto v = make_projected_cap_view(g);
   ASSERT_EQ(v.which_case, 3) << name;
   const auto s = sample_projected_spherical_cap<T>(v, Vec2<T>(T(0), T(0.5)));
@@ -296,7 +301,8 @@ TEST(ProjectedCapFrame, OverheadLightGivesTheSameSamplesInDoubleAndLongDouble) {
         const auto a = sample_projected_spherical_cap<double>(vd, Vec2<double>(u0, u1));
         const auto b = sample_projected_spherical_cap<Real>(vl, Vec2<Real>(u0, u1));
         ASSERT_TRUE(a.valid() && b.valid());
-        EXPECT_LT(double((to_long(a.direction) - b.direction).norm()), 1e-12) << double(log_d) << " " << u0 << " " << u1;
+        EXPECT_LT(double((to_long(a.direction) - b.direction).norm()), 1e-12)
+            << double(log_d) << " " << u0 << " " << u1;
       }
   }
 }
@@ -327,7 +333,12 @@ FloatPdfError float_sample_pdf_error(const ProjectedCapConfig& c, int n) {
     const auto a = sample_projected_spherical_cap<float>(vf, u);
     const auto b = sample_projected_spherical_cap<Real>(vl, Vec2<Real>(u[0], u[1]));
     if (!a.valid() || !b.valid()) continue;
-    if (double(std::abs(Real(a.pdf) / b.pdf - 1)) > e.kernel) { e.u0 = u[0]; e.u1 = u[1]; const Vec3<float> wl = vf.to_local(a.direction); e.wz = wl.z(); }
+    if (double(std::abs(Real(a.pdf) / b.pdf - 1)) > e.kernel) {
+      e.u0 = u[0];
+      e.u1 = u[1];
+      const Vec3<float> wl = vf.to_local(a.direction);
+      e.wz = wl.z();
+    }
     e.kernel = std::max(e.kernel, double(std::abs(Real(a.pdf) / b.pdf - 1)));
     const Vec3<float> w = vf.to_local(a.direction);
     const float naive_z = std::sqrt(std::max(0.0f, 1 - (w.x() * w.x() + w.y() * w.y())));
@@ -396,9 +407,9 @@ TEST(ProjectedCapScale, SubnormalAndHugeLightsSampleExactlyLikeTheSameLightAtUni
   // multiplied by a power of two. A light at 2^-1074 (c - x = (1, 3, -1) denorm_min, fuzz_projected_cap_double
   // 07252d59: |c - x| rounded to 3 denorm_min gave |w_d| = 1.106 and A_E + A_D 40 % off; before the fix all 15
   // samples of each normal below differed) and one at 2^900 (where |c - x|^2 would overflow; stableNorm avoided
-  // that already, and those passed before) must give bit-identical views, samples and densities to the unit-scale light: every
-  // coordinate below is an integer times the scale, so c - x is exact at each scale, and the view is built from
-  // (c - x) 2^-e, r 2^-e (unit_scale_geometry) in all three.
+  // that already, and those passed before) must give bit-identical views, samples and densities to the unit-scale
+  // light: every coordinate below is an integer times the scale, so c - x is exact at each scale, and the view is built
+  // from (c - x) 2^-e, r 2^-e (unit_scale_geometry) in all three.
   const Vec3<double> c0(0, 3, 3), x0(-1, 0, 4);
   const Vec3<double> wd = (c0 - x0).normalized(), side = Vec3<double>(1, 0, 1).normalized();  // side . wd = 0
   int cases_seen[4] = {0, 0, 0, 0};
@@ -424,7 +435,8 @@ TEST(ProjectedCapScale, SubnormalAndHugeLightsSampleExactlyLikeTheSameLightAtUni
           if (!a.valid()) continue;
           EXPECT_EQ(a.direction, b.direction) << h << " " << exponent << " " << u0 << " " << u1;
           EXPECT_EQ(a.pdf, b.pdf) << h << " " << exponent << " " << u0 << " " << u1;
-          EXPECT_EQ(pdf_projected_spherical_cap<double>(v, a.direction), pdf_projected_spherical_cap<double>(vu, a.direction));
+          EXPECT_EQ(pdf_projected_spherical_cap<double>(v, a.direction),
+                    pdf_projected_spherical_cap<double>(vu, a.direction));
         }
     }
   }
@@ -451,7 +463,8 @@ TEST(ProjectedCapScale, ALightOverheadToASubnormalHorizontalPartIsSampledInsideI
       const auto s = sample_projected_spherical_cap<double>(v, Vec2<double>(u0, u1));
       ASSERT_TRUE(s.valid()) << u0 << " " << u1;
       // the cap's axis is +z to 1e-318
-      const long double angle = std::acos(std::min(1.0L, (long double)s.direction.z() / s.direction.cast<long double>().norm()));
+      const long double angle =
+          std::acos(std::min(1.0L, (long double)s.direction.z() / s.direction.cast<long double>().norm()));
       // samples at u0 = 0, 1 lie on the rim: a few eps of the kernel's rounding, times 1 / sin(theta_max) = 3.4 in acos
       EXPECT_LE(angle, theta_max + 1e-12L) << u0 << " " << u1;
     }

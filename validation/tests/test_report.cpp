@@ -50,10 +50,12 @@ int chromium(const fs::path& page, const std::string& mode_flag, const fs::path&
   const std::string id = std::to_string(::getpid()) + "-" + std::to_string(counter++);
   const fs::path profile = tmp / ("profile-" + id), o = tmp / ("chromium-" + id + ".out"),
                  e = tmp / ("chromium-" + id + ".err");
-  const std::string cmd = "timeout 60 chromium --headless --no-sandbox --disable-gpu --hide-scrollbars "
-                          "--no-first-run --enable-logging=stderr --v=0 --virtual-time-budget=3000 "
-                          "--user-data-dir='" + profile.string() + "' " + mode_flag + " 'file://" +
-                          fs::absolute(page).string() + "' > '" + o.string() + "' 2> '" + e.string() + "'";
+  const std::string cmd =
+      "timeout 60 chromium --headless --no-sandbox --disable-gpu --hide-scrollbars "
+      "--no-first-run --enable-logging=stderr --v=0 --virtual-time-budget=3000 "
+      "--user-data-dir='" +
+      profile.string() + "' " + mode_flag + " 'file://" + fs::absolute(page).string() + "' > '" + o.string() +
+      "' 2> '" + e.string() + "'";
   const int status = std::system(cmd.c_str());
   out = slurp(o);
   err = slurp(e);
@@ -197,8 +199,9 @@ TEST(Report, OpensInHeadlessChromiumWithEveryImageAndLinkLoadedAndNoConsoleError
   // Each kernel page shows the observed, expected and residual maps of its chi2 test.
   EXPECT_EQ(total_images, 6u);
   std::string out, err;
-  EXPECT_EQ(chromium(f.site / "index.html", "--window-size=1280,1400 --screenshot='" + (f.dir / "index.png").string() + "'",
-                     f.dir, out, err), 0);
+  EXPECT_EQ(chromium(f.site / "index.html",
+                     "--window-size=1280,1400 --screenshot='" + (f.dir / "index.png").string() + "'", f.dir, out, err),
+            0);
   ASSERT_TRUE(fs::exists(f.dir / "index.png"));
   EXPECT_GT(fs::file_size(f.dir / "index.png"), 10000u);
 }
@@ -228,7 +231,8 @@ TEST(Report, PageCheckReportsAMissingImageABrokenLinkAndAConsoleError) {
   const auto problems = page_problems(page, f.dir);
   bool broken = false, missing = false, link = false, console = false;
   for (const auto& p : problems) {
-    broken = broken || (p.find("image did not load") != std::string::npos && p.find(victim.filename().string()) != std::string::npos);
+    broken = broken || (p.find("image did not load") != std::string::npos &&
+                        p.find(victim.filename().string()) != std::string::npos);
     missing = missing || p.find("missing link target img/" + victim.filename().string()) != std::string::npos;
     link = link || p.find("missing link target nowhere.html") != std::string::npos;
     console = console || p.find("console.error: injected") != std::string::npos;
@@ -279,8 +283,8 @@ TEST(Report, ResidualMapExrHoldsTheSignedResidualOfEveryBin) {
   for (const Result& r : run.results) {
     if (r.test != "chi2") continue;
     ASSERT_GT(r.map_rows, 0);
-    const fs::path exr = f.site / "img" /
-                         (safe_name(r.kernel) + "__" + safe_name(r.scalar) + "__" + safe_name(r.config) + "__chi2.exr");
+    const fs::path exr =
+        f.site / "img" / (safe_name(r.kernel) + "__" + safe_name(r.scalar) + "__" + safe_name(r.config) + "__chi2.exr");
     int w = 0, h = 0;
     const auto obs = read_exr_channel(exr.string(), "observed", w, h);
     const auto res = read_exr_channel(exr.string(), "residual", w, h);
@@ -299,13 +303,15 @@ TEST(Report, ResidualMapExrHoldsTheSignedResidualOfEveryBin) {
 TEST(Report, ParserRejectsResultsWithoutTheRequiredMembers) {
   EXPECT_THROW(parse_battery_json("{}"), std::runtime_error);
   EXPECT_THROW(parse_battery_json("not json"), std::runtime_error);
-  EXPECT_THROW(parse_battery_json(R"({"alpha":0.01,"correction":"holm","statistical_tests":1,"results":[{"kernel":"k"}]})"),
-               std::runtime_error);
+  EXPECT_THROW(
+      parse_battery_json(R"({"alpha":0.01,"correction":"holm","statistical_tests":1,"results":[{"kernel":"k"}]})"),
+      std::runtime_error);
   // A map whose size disagrees with rows x cols.
-  EXPECT_THROW(parse_battery_json(R"({"alpha":0.01,"correction":"holm","statistical_tests":1,"results":[{"kernel":"k",)"
-                                  R"("scalar":"double","config":"c","test":"chi2","statistic":1,"p_value":0.5,"passed":true,)"
-                                  R"("map":{"rows":2,"cols":2,"observed":[1,2,3],"expected":[1,2,3,4]}}]})"),
-               std::runtime_error);
+  EXPECT_THROW(
+      parse_battery_json(R"({"alpha":0.01,"correction":"holm","statistical_tests":1,"results":[{"kernel":"k",)"
+                         R"("scalar":"double","config":"c","test":"chi2","statistic":1,"p_value":0.5,"passed":true,)"
+                         R"("map":{"rows":2,"cols":2,"observed":[1,2,3],"expected":[1,2,3,4]}}]})"),
+      std::runtime_error);
   // Infinity as battery.h writes it (1e999) and null statistics are accepted.
   const auto run = parse_battery_json(R"({"alpha":0.01,"correction":"holm","statistical_tests":1,"results":[)"
                                       R"({"kernel":"k","scalar":"double","config":"c","test":"chi2","statistic":1e999,)"
@@ -358,7 +364,8 @@ TEST(Report, KnownLimitationFailuresAreMarkedDistinctlyAndDoNotFailTheRun) {
   EXPECT_EQ(sum.known_limitation_failures, 1u);
   const std::string index = slurp(dir / "site" / "index.html");
   EXPECT_EQ(index.find("<td class=\"fail\""), std::string::npos);
-  EXPECT_NE(index.find("<td class=\"known\" title=\"fail (known limitation): d [known limitation: float cannot resolve it]\""),
+  EXPECT_NE(index.find(
+                "<td class=\"known\" title=\"fail (known limitation): d [known limitation: float cannot resolve it]\""),
             std::string::npos);
   EXPECT_NE(index.find("banner good"), std::string::npos);
   EXPECT_NE(index.find("INCOMPLETE"), std::string::npos);

@@ -64,8 +64,8 @@ template <class T> void expect_unit_directions_inside_the_cone_with_matching_pdf
       if (!s.valid()) continue;  // only u0 == 1 on the silhouette may fail, and U never gives it
       EXPECT_NEAR(double(s.direction.norm()), 1.0, double(tol));
       EXPECT_TRUE(view.cap().contains(s.direction, tol));
-      const T pdf = kernel == 0 ? pdf_sphere_solid_angle(view, s.direction)
-                                : pdf_sphere_visible_area(view, g.light, s.direction);
+      const T pdf =
+          kernel == 0 ? pdf_sphere_solid_angle(view, s.direction) : pdf_sphere_visible_area(view, g.light, s.direction);
       // pdf(direction) re-derives the density from a direction that carries a few ulps of rounding. For the
       // solid-angle kernel the density is constant; for the visible-area kernel its relative sensitivity to an
       // angular perturbation is kappa = (d / r) q / cos_light^2 (differentiate dist^2 / cos_light with
@@ -152,7 +152,8 @@ TEST(CubeRootSquaredForFloat, IsWithinAnUlpOverEveryFloatOfOnePeriodAndScalesExa
     const float x = m(rng);
     const int k = int(rng() % 83) - 41;  // 8^k x and (8^k x)^(2/3) = 4^k x^(2/3) normal floats
     EXPECT_EQ(warpcheck::cube_root_squared_for_float(std::ldexp(x, 3 * k)),
-              std::ldexp(warpcheck::cube_root_squared_for_float(x), 2 * k)) << x << " " << k;
+              std::ldexp(warpcheck::cube_root_squared_for_float(x), 2 * k))
+        << x << " " << k;
   }
   EXPECT_EQ(warpcheck::cube_root_squared_for_float(0.0f), 0.0f);
   EXPECT_EQ(warpcheck::cube_root_squared_for_float(-8.0f), 4.0f);  // outside: std::cbrt

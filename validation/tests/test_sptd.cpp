@@ -34,13 +34,12 @@ Cap<L> random_cap(std::mt19937_64& g, L min_omc = 0.01L, L max_omc = 1.99L) {
 const L kPivotNorms[] = {0, 0.3L, 0.7L, 0.95L, 0.999L};
 
 // Quadrature for the tests (its measured accuracy here: ~1e-8 relative, limited by the outer integral across
-// tangencies; hence the 1e-7 tolerances below). The battery's integrate_cap_region copes with jumps by deep bisection, which is
-// slow and stalls near 1e-8 for the clamped cosine's kink. These integrands are smooth except across one
-// known circle {w : w.m = h} (the kink of the clamped cosine, or a cap's edge), so we integrate over a cap in
-// polar coordinates (theta from the cap's axis, phi) and split each meridian where it crosses that circle
-// (R cos(theta - delta) = h in closed form): every piece is smooth and Gauss-Kronrod converges fast. Where
-// the circle comes from kernel code (a transformed cap), a wrong circle only costs accuracy, so it cannot
-// make a wrong closed form agree.
+// tangencies; hence the 1e-7 tolerances below). The battery's integrate_cap_region copes with jumps by deep bisection,
+// which is slow and stalls near 1e-8 for the clamped cosine's kink. These integrands are smooth except across one known
+// circle {w : w.m = h} (the kink of the clamped cosine, or a cap's edge), so we integrate over a cap in polar
+// coordinates (theta from the cap's axis, phi) and split each meridian where it crosses that circle (R cos(theta -
+// delta) = h in closed form): every piece is smooth and Gauss-Kronrod converges fast. Where the circle comes from
+// kernel code (a transformed cap), a wrong circle only costs accuracy, so it cannot make a wrong closed form agree.
 struct Circle {
   Vec3L m = Vec3L(0, 0, 1);
   L h = 2;  // no circle (|h| > 1)
@@ -71,7 +70,8 @@ L integrate_cap_split(const std::function<L(const Vec3L&)>& f, const Cap<L>& cap
   return GK::integrate(inner, L(0), kTwoPi<L>, 14, 1e-12L);
 }
 // Over the whole sphere in a frame centred on `towards` (put the SPTD's peak, the pivot's direction, there).
-L integrate_sphere(const std::function<L(const Vec3L&)>& f, const Vec3L& towards, const std::vector<Circle>& circles = {}) {
+L integrate_sphere(const std::function<L(const Vec3L&)>& f, const Vec3L& towards,
+                   const std::vector<Circle>& circles = {}) {
   const Vec3L axis = towards.norm() > 0 ? Vec3L(towards / towards.norm()) : Vec3L(0, 0, 1);
   return integrate_cap_split(f, Cap<L>{axis, 2}, circles);
 }
@@ -175,8 +175,7 @@ TEST(SptdPivot, JacobianEq4MatchesFourthOrderFiniteDifferencesInLongDouble) {
 // computes it, or a deliberately wrong formula for the failing counterpart) over the pivots and directions.
 using AD = boost::math::differentiation::autodiff_fvar<L, 1>;
 
-template <class Transform, class Jacobian>
-L worst_autodiff_jacobian_error(Transform&& transform, Jacobian&& jacobian) {
+template <class Transform, class Jacobian> L worst_autodiff_jacobian_error(Transform&& transform, Jacobian&& jacobian) {
   std::mt19937_64 g(19);
   L worst = 0;
   for (L r : kPivotNorms) {
@@ -201,8 +200,8 @@ TEST(SptdPivot, JacobianEq4MatchesAutodiffOfTheKernelsTransformInLongDouble) {
   auto eq4 = [](const Vec3L& w, const Vec3L& rp) { return pivot_jacobian(w, rp); };
   // The kernel's sphere form and Eq. 2 verbatim, both differentiated by autodiff (measured worst: 8.7e-19 and
   // 2.3e-16; the verbatim form cancels in its denominator near |r_p| = 1).
-  const L sphere_form = worst_autodiff_jacobian_error(
-      [](const Vec3<AD>& w, const Vec3<AD>& rp) { return pivot_transform(w, rp); }, eq4);
+  const L sphere_form =
+      worst_autodiff_jacobian_error([](const Vec3<AD>& w, const Vec3<AD>& rp) { return pivot_transform(w, rp); }, eq4);
   const L eq2_form = worst_autodiff_jacobian_error(
       [](const Vec3<AD>& w, const Vec3<AD>& rp) { return pivot_transform_point(w, rp); }, eq4);
   EXPECT_LT(sphere_form, 1e-14L);
@@ -212,13 +211,13 @@ TEST(SptdPivot, JacobianEq4MatchesAutodiffOfTheKernelsTransformInLongDouble) {
   const L radius_ratio = worst_autodiff_jacobian_error(
       [](const Vec3<AD>& w, const Vec3<AD>& rp) { return pivot_transform(w, rp); },
       [](const Vec3L& w, const Vec3L& rp) { return (1 - rp.squaredNorm()) / (w - rp).squaredNorm(); });
-  const L flipped = worst_autodiff_jacobian_error(
-      [](const Vec3<AD>& w, const Vec3<AD>& rp) { return pivot_transform(w, rp); },
-      [](const Vec3L& w, const Vec3L& rp) { return pivot_jacobian(w, Vec3L(-rp)); });
+  const L flipped =
+      worst_autodiff_jacobian_error([](const Vec3<AD>& w, const Vec3<AD>& rp) { return pivot_transform(w, rp); },
+                                    [](const Vec3L& w, const Vec3L& rp) { return pivot_jacobian(w, Vec3L(-rp)); });
   EXPECT_GT(radius_ratio, 0.1L);
   EXPECT_GT(flipped, 0.1L);
-  std::printf("[ measured ] Eq. 4 vs autodiff: sphere form %.1Le, Eq. 2 form %.1Le; counterparts %.2Lg, %.2Lg\n", sphere_form,
-              eq2_form, radius_ratio, flipped);
+  std::printf("[ measured ] Eq. 4 vs autodiff: sphere form %.1Le, Eq. 2 form %.1Le; counterparts %.2Lg, %.2Lg\n",
+              sphere_form, eq2_form, radius_ratio, flipped);
 }
 
 TEST(SptdDensity, Eq9NormalisationHoldsByQuadratureForBothBases) {
@@ -283,7 +282,8 @@ template <class CapTransform> CapInvariance measure_cap_invariance(CapTransform&
 }
 
 TEST(SptdCaps, BoundaryOfCMapsOntoBoundaryOfGCInLongDouble) {
-  const CapInvariance m = measure_cap_invariance([](const Cap<L>& c, const Vec3L& rp) { return pivot_transform_cap(c, rp); });
+  const CapInvariance m =
+      measure_cap_invariance([](const Cap<L>& c, const Vec3L& rp) { return pivot_transform_cap(c, rp); });
   EXPECT_LT(m.worst_boundary, 1e-12L);
   EXPECT_EQ(m.interior_missed, 0);
   EXPECT_GT(m.large_images, 50);  // image caps larger than a hemisphere are covered (Eq. 6's failure case)
@@ -300,7 +300,7 @@ TEST(SptdCaps, CapInvarianceCheckRejectsEq6AsPrintedAndASlightlyWrongAperture) {
     const Vec3L g1 = pivot_transform(Vec3L(cos_a * c.axis + sin_a * t), rp);
     const Vec3L g2 = pivot_transform(Vec3L(cos_a * c.axis - sin_a * t), rp);
     const Vec3L axis = (g1 + g2).normalized();  // Eq. 6
-    return Cap<L>{axis, 1 - axis.dot(g1)};       // Eq. 7
+    return Cap<L>{axis, 1 - axis.dot(g1)};      // Eq. 7
   };
   const CapInvariance printed = measure_cap_invariance(as_printed);
   EXPECT_GT(printed.worst_boundary, 1e-12L);
@@ -364,14 +364,15 @@ TEST(SptdCaps, ClosedFormCapIntegralsEq10MatchQuadratureOfEq8) {
     }
   }
   EXPECT_LT(worst_cap_integral_error([](const Sptd<L>& d, const Cap<L>& c) { return sptd_cap_integral(d, c); }), 1e-7L);
-  EXPECT_GE(crossing, 3);     // the horizon-crossing formula is exercised
-  EXPECT_GE(below_axis, 1);   // ... including the crescent (cap axis below the horizon)
-  EXPECT_GE(large_images, 1); // ... and an image cap larger than a hemisphere
+  EXPECT_GE(crossing, 3);      // the horizon-crossing formula is exercised
+  EXPECT_GE(below_axis, 1);    // ... including the crescent (cap axis below the horizon)
+  EXPECT_GE(large_images, 1);  // ... and an image cap larger than a hemisphere
   // Failing counterparts (here, not in a test of their own, so that the quadrature runs once per process): the
   // comparison rejects a closed form 1e-6 off (10 times its bound) and the clamped cosine's projected area
   // without the horizon (the whole ellipse E, which is wrong whenever g(C) crosses it).
-  EXPECT_GT(worst_cap_integral_error([](const Sptd<L>& d, const Cap<L>& c) { return sptd_cap_integral(d, c) * (1 + 1e-6L); }),
-            1e-7L);
+  EXPECT_GT(
+      worst_cap_integral_error([](const Sptd<L>& d, const Cap<L>& c) { return sptd_cap_integral(d, c) * (1 + 1e-6L); }),
+      1e-7L);
   EXPECT_GT(worst_cap_integral_error([](const Sptd<L>& d, const Cap<L>& c) {
               if (d.base == SptdBase::kUniform) return sptd_cap_integral(d, c);
               const auto v = make_cosine_cap_view(pivot_transform_cap(c, d.pivot), d.base_axis);
@@ -483,8 +484,9 @@ TEST(SptdCaps, UniformSptdOverTwoCapsEq19MatchesQuadrature) {
       Sptd<L> d;
       d.pivot = rp;
       const L closed = sptd_uniform_two_cap_integral(rp, c, h);
-      const L quad = integrate_sphere([&](const Vec3L& w) { return c.contains(w) && h.contains(w) ? sptd_density(d, w) : L(0); },
-                                      rp, {boundary_of(c), boundary_of(h)});
+      const L quad =
+          integrate_sphere([&](const Vec3L& w) { return c.contains(w) && h.contains(w) ? sptd_density(d, w) : L(0); },
+                           rp, {boundary_of(c), boundary_of(h)});
       EXPECT_NEAR(closed, quad, 1e-7L * std::max<L>(quad, 1e-2L)) << "|r_p| " << double(r);
     }
   }

@@ -69,9 +69,9 @@ TEST(WorstCaseCli, ASigkilledRunRestartedWithTheSameCommandLosesNoBestAndContinu
   ASSERT_FALSE(cli.empty()) << "warpcheck executable not found next to the test binary (build it)";
   TempDir dir;
   const fs::path ckpt = dir.path / "ckpt.json", out = dir.path / "out.json";
-  const std::vector<std::string> cmd = {cli.string(), "worst-case", "--search", "polygon-backward-k1", "--seconds", "5",
-                                        "--checkpoint", ckpt.string(), "--checkpoint-every", "0.3", "--progress", "0",
-                                        "--json", out.string()};
+  const std::vector<std::string> cmd = {
+      cli.string(),  "worst-case",         "--search", "polygon-backward-k1", "--seconds", "5",      "--checkpoint",
+      ckpt.string(), "--checkpoint-every", "0.3",      "--progress",          "0",         "--json", out.string()};
   const pid_t first = spawn(cmd, dir.path / "first.log");
   // Wait for a checkpoint with some chains in it, then kill without warning.
   const auto t0 = std::chrono::steady_clock::now();
@@ -86,7 +86,7 @@ TEST(WorstCaseCli, ASigkilledRunRestartedWithTheSameCommandLosesNoBestAndContinu
   }
   ASSERT_EQ(kill(first, SIGKILL), 0);
   EXPECT_EQ(wait_status(first), 128 + SIGKILL);
-  EXPECT_FALSE(fs::exists(out));  // it really died before finishing
+  EXPECT_FALSE(fs::exists(out));                               // it really died before finishing
   const SearchRecord at_kill = record_from_json(slurp(ckpt));  // the file is whole: written atomically
   EXPECT_GE(at_kill.chains, before.chains);
 
@@ -95,12 +95,13 @@ TEST(WorstCaseCli, ASigkilledRunRestartedWithTheSameCommandLosesNoBestAndContinu
   const double second_wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
   const SearchRecord after = record_from_json(slurp(out));
   EXPECT_NE(slurp(dir.path / "second.log").find("resuming from"), std::string::npos);
-  EXPECT_GE(after.best_f, at_kill.best_f);             // no best-so-far lost
+  EXPECT_GE(after.best_f, at_kill.best_f);  // no best-so-far lost
   ASSERT_FALSE(at_kill.history.empty());
   ASSERT_GE(after.history.size(), at_kill.history.size());  // and its history continues the killed run's
-  for (std::size_t i = 0; i < at_kill.history.size(); ++i) EXPECT_EQ(after.history[i].best_f, at_kill.history[i].best_f);
-  EXPECT_GT(after.chains, at_kill.chains);             // and it went on
-  EXPECT_GE(after.next_local, at_kill.next_local);     // with chains it had not done
+  for (std::size_t i = 0; i < at_kill.history.size(); ++i)
+    EXPECT_EQ(after.history[i].best_f, at_kill.history[i].best_f);
+  EXPECT_GT(after.chains, at_kill.chains);          // and it went on
+  EXPECT_GE(after.next_local, at_kill.next_local);  // with chains it had not done
   EXPECT_GT(after.evaluations, at_kill.evaluations);
   EXPECT_GE(after.seconds, 5.0);
   EXPECT_LT(second_wall, 5.0 - at_kill.seconds + 2.0);  // it used the remaining budget, not a fresh one
@@ -110,12 +111,13 @@ TEST(WorstCaseCli, BadArgumentsExitWithStatusTwo) {
   const fs::path cli = cli_path();
   ASSERT_FALSE(cli.empty());
   TempDir dir;
-  for (const std::vector<std::string>& bad :
-       {std::vector<std::string>{"worst-case"}, {"worst-case", "--search", "no-such-search"},
-        {"worst-case", "--search", "polygon-backward-k0", "--shard", "3/3"},
-        {"worst-case", "--search", "polygon-backward-k0", "--seconds", "-1"},
-        {"worst-case", "--search", "polygon-backward-k0", "--threads", "x"}, {"worst-case", "--frobnicate"},
-        {"merge"}}) {
+  for (const std::vector<std::string>& bad : {std::vector<std::string>{"worst-case"},
+                                              {"worst-case", "--search", "no-such-search"},
+                                              {"worst-case", "--search", "polygon-backward-k0", "--shard", "3/3"},
+                                              {"worst-case", "--search", "polygon-backward-k0", "--seconds", "-1"},
+                                              {"worst-case", "--search", "polygon-backward-k0", "--threads", "x"},
+                                              {"worst-case", "--frobnicate"},
+                                              {"merge"}}) {
     std::vector<std::string> args = {cli.string()};
     args.insert(args.end(), bad.begin(), bad.end());
     EXPECT_EQ(wait_status(spawn(args, dir.path / "log")), 2) << bad.back();
@@ -129,17 +131,19 @@ TEST(WorstCaseCli, EvaluatePrintsTheObjectiveAtARecordedInput) {
   TempDir dir;
   const fs::path rec = fs::path(WARPCHECK_SOURCE_DIR) / "data" / "worst-cases" / "projected-cap-quintic.json";
   const SearchRecord r = record_from_json(slurp(rec));
-  EXPECT_EQ(wait_status(spawn({cli.string(), "worst-case", "--search", "projected-cap-quintic", "--evaluate", rec.string()},
-                              dir.path / "log", dir.path / "out")),
-            0)
+  EXPECT_EQ(
+      wait_status(spawn({cli.string(), "worst-case", "--search", "projected-cap-quintic", "--evaluate", rec.string()},
+                        dir.path / "log", dir.path / "out")),
+      0)
       << slurp(dir.path / "log");
   char expected[64];
   std::snprintf(expected, sizeof expected, ": %.6Le\n", r.best_f);
   EXPECT_NE(slurp(dir.path / "out").find(expected), std::string::npos) << slurp(dir.path / "out") << " vs " << expected;
   // An input of a search with other parameters is a usage error.
-  EXPECT_EQ(wait_status(spawn({cli.string(), "worst-case", "--search", "polygon-backward-k0", "--evaluate", rec.string()},
-                              dir.path / "log")),
-            2);
+  EXPECT_EQ(
+      wait_status(spawn({cli.string(), "worst-case", "--search", "polygon-backward-k0", "--evaluate", rec.string()},
+                        dir.path / "log")),
+      2);
 }
 
 // --evaluate with --json re-records an input with the current kernels: a record whose error was tampered with

@@ -59,7 +59,8 @@ TEST(RecordedWorstCases, AreNoWorseWithTheCurrentKernels) {
     if (std::isnan(now) && s->resolution_depends_on_cpu) {
       // Not a verdict on the kernel: the finite-difference resolution test at this input came out the other
       // way on this CPU (see Search::resolution_depends_on_cpu). Reported, and the record stays as it is.
-      std::cout << "note: " << name << ": the recorded input is unresolved on this CPU (h and 2h differences "
+      std::cout << "note: " << name
+                << ": the recorded input is unresolved on this CPU (h and 2h differences "
                    "disagree); not compared\n";
       continue;
     }
@@ -67,7 +68,8 @@ TEST(RecordedWorstCases, AreNoWorseWithTheCurrentKernels) {
     // Slack of one part in 1e9: a kernel edit that only changes rounding moves a recorded error by ~1e-12
     // relative (measured after the issue-7 fixes to polygon_projected.h), which is not a regression; a worst
     // case that gets worse by more than that is.
-    EXPECT_LE(now, r.best_f * (1 + kReplaySlack)) << r.search << ": recorded " << r.best_f << " (" << r.kernel_version << "), now " << now;
+    EXPECT_LE(now, r.best_f * (1 + kReplaySlack))
+        << r.search << ": recorded " << r.best_f << " (" << r.kernel_version << "), now " << now;
   }
 }
 

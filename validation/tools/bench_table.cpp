@@ -29,10 +29,14 @@ namespace {
 
 // Paper ratios (see header). 2019 Table 2: columns qz = 2, 0.1, -0.9 at 1 spl; 2, 0.1, -0.1, -0.9 at 500 spl.
 std::optional<double> paper_cap_ratio(const std::string& qz, int spl) {
-  struct Row { const char* qz; int spl; double base, solid, ours; };
+  struct Row {
+    const char* qz;
+    int spl;
+    double base, solid, ours;
+  };
   static const Row rows[] = {
-      {"2", 1, 2.1, 8.2, 10.1},     {"0.1", 1, 2.1, 7.4, 12.9},   {"-0.9", 1, 2.2, 6.3, 15.1},
-      {"2", 500, 2.0, 4.8, 6.3},    {"0.1", 500, 2.1, 4.0, 6.4},  {"-0.1", 500, 2.0, 3.8, 8.4},
+      {"2", 1, 2.1, 8.2, 10.1},     {"0.1", 1, 2.1, 7.4, 12.9},  {"-0.9", 1, 2.2, 6.3, 15.1},
+      {"2", 500, 2.0, 4.8, 6.3},    {"0.1", 500, 2.1, 4.0, 6.4}, {"-0.1", 500, 2.0, 3.8, 8.4},
       {"-0.9", 500, 2.1, 3.1, 8.4},
   };
   for (const Row& r : rows)
@@ -82,7 +86,8 @@ int main(int argc, char** argv) {
     if (!o.contains("items_per_second")) continue;
     t[std::string(o.at("name").as_string())] = 1.0 / o.at("items_per_second").to_number<double>();
   }
-  auto net = [&](const std::string& kernel, const std::string& family, const std::string& rest) -> std::optional<double> {
+  auto net = [&](const std::string& kernel, const std::string& family,
+                 const std::string& rest) -> std::optional<double> {
     const auto k = t.find(kernel + rest), base = t.find(family + "_baseline" + rest);
     if (k == t.end() || base == t.end()) return std::nullopt;
     return k->second - base->second;
@@ -94,20 +99,23 @@ int main(int argc, char** argv) {
 
   std::printf("Per-sample costs (ns, baseline subtracted) and ratios; measured from %s\n\n", argv[1]);
   std::printf("Projected spherical cap / sphere solid angle (Peters & Dachsbacher 2019 Table 2 configurations)\n");
-  std::printf("%-7s %-5s %5s %10s %10s %8s %8s %7s\n", "scalar", "qz", "spl", "solid ns", "proj ns", "ratio", "paper", "<=2?");
+  std::printf("%-7s %-5s %5s %10s %10s %8s %8s %7s\n", "scalar", "qz", "spl", "solid ns", "proj ns", "ratio", "paper",
+              "<=2?");
   for (const char* T : {"float", "double"})
     for (int spl : {1, 500})
       for (const char* qz : {"2", "0.1", "-0.1", "-0.9"}) {
         const std::string rest = std::string("/") + T + "/qz=" + qz + "/spl=" + std::to_string(spl);
         const auto s = net("sphere_solid_angle", "sphere", rest), p = net("projected_cap", "sphere", rest);
         const auto r = ratio(p, s);
-        std::printf("%-7s %-5s %5d %10s %10s %8s %8s %7s\n", T, qz, spl, fmt(s ? std::optional(*s * 1e9) : std::nullopt).c_str(),
+        std::printf("%-7s %-5s %5d %10s %10s %8s %8s %7s\n", T, qz, spl,
+                    fmt(s ? std::optional(*s * 1e9) : std::nullopt).c_str(),
                     fmt(p ? std::optional(*p * 1e9) : std::nullopt).c_str(), fmt(r).c_str(),
                     fmt(paper_cap_ratio(qz, spl)).c_str(), spl == 500 && r ? (*r <= 2 ? "yes" : "NO") : "");
       }
 
   std::printf("\nPolygon projected / polygon solid angle (Peters 2021 Table 1 configurations)\n");
-  std::printf("%-7s %-12s %5s %10s %10s %8s %8s %7s\n", "scalar", "config", "spl", "solid ns", "proj ns", "ratio", "paper", "<=4?");
+  std::printf("%-7s %-12s %5s %10s %10s %8s %8s %7s\n", "scalar", "config", "spl", "solid ns", "proj ns", "ratio",
+              "paper", "<=4?");
   for (const char* T : {"float", "double"})
     for (int spl : {1, 500})
       for (bool central : {false, true})

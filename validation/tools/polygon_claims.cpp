@@ -57,9 +57,12 @@ int main(int argc, char** argv) {
     }
     const std::string v = argv[++i];
     command += " " + v;
-    if (a == "--cases") cases = std::atol(v.c_str());
-    else if (a == "--seed") seed = std::strtoul(v.c_str(), nullptr, 10);
-    else if (a == "--out") out = v;
+    if (a == "--cases")
+      cases = std::atol(v.c_str());
+    else if (a == "--seed")
+      seed = std::strtoul(v.c_str(), nullptr, 10);
+    else if (a == "--out")
+      out = v;
     else {
       std::fprintf(stderr, "unknown option %s\n", a.c_str());
       return 2;
@@ -105,12 +108,16 @@ int main(int argc, char** argv) {
   j += "  \"cases\": " + std::to_string(cases) + ",\n  \"seed\": " + std::to_string(seed) + ",\n";
   j += "  \"case_distribution\": \"triangles with vertex directions uniform on the upper hemisphere, decentral only; "
        "a uniformly chosen sector of area >= 1e-2 and <= 179.999 deg; target uniform in the sector (long double)\",\n";
-  j += "  \"backward_error_two_iterations\": {\"measured\": " + json(s2) + ", \"paper\": {\"p99\": 4.6e-15, \"max\": 1.8e-5}},\n";
+  j += "  \"backward_error_two_iterations\": {\"measured\": " + json(s2) +
+       ", \"paper\": {\"p99\": 4.6e-15, \"max\": 1.8e-5}},\n";
   j += "  \"backward_error_three_iterations\": {\"measured\": " + json(s3) + "},\n";
-  j += "  \"backward_error_no_iteration\": {\"measured\": " + json(s0) + ", \"paper\": {\"p99\": 0.02, \"max\": 0.27}},\n";
-  j += "  \"biased_atan2_forward_error_rad\": {\"measured_max\": " + json_number(atan_err) + ", \"paper_bound\": 1.2e-5},\n";
+  j += "  \"backward_error_no_iteration\": {\"measured\": " + json(s0) +
+       ", \"paper\": {\"p99\": 0.02, \"max\": 0.27}},\n";
+  j += "  \"biased_atan2_forward_error_rad\": {\"measured_max\": " + json_number(atan_err) +
+       ", \"paper_bound\": 1.2e-5},\n";
   j += "  \"biased_backward_error_per_sector\": {\"measured\": " + json(sb) + "},\n";
-  j += "  \"biased_xi0_backward_error_whole_polygon\": {\"measured\": " + json(sx) + ", \"polygons\": " + std::to_string(xi_err.size()) + "},\n";
+  j += "  \"biased_xi0_backward_error_whole_polygon\": {\"measured\": " + json(sx) +
+       ", \"polygons\": " + std::to_string(xi_err.size()) + "},\n";
   j += "  \"biased_normaliser_relative_error\": {\"measured\": " + json(sn) + "}\n}\n";
   std::ofstream(out) << j;
   std::fputs(j.c_str(), stdout);

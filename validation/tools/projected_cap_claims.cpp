@@ -29,8 +29,10 @@ int main(int argc, char** argv) {
   std::string command = "build/projected_cap_claims";
   for (int i = 1; i < argc; ++i) {
     command += std::string(" ") + argv[i];
-    if (!std::strcmp(argv[i], "--configurations") && i + 1 < argc) configurations = std::stol(argv[++i]), command += std::string(" ") + argv[i];
-    else if (!std::strcmp(argv[i], "--out") && i + 1 < argc) out = argv[++i], command += std::string(" ") + argv[i];
+    if (!std::strcmp(argv[i], "--configurations") && i + 1 < argc)
+      configurations = std::stol(argv[++i]), command += std::string(" ") + argv[i];
+    else if (!std::strcmp(argv[i], "--out") && i + 1 < argc)
+      out = argv[++i], command += std::string(" ") + argv[i];
     else {
       std::fprintf(stderr, "usage: projected_cap_claims [--configurations N] [--out FILE]\n");
       return 2;
@@ -43,34 +45,40 @@ int main(int argc, char** argv) {
 
   const QuinticError q = quintic_max_error(20000);
   std::printf("quintic (Alg. 5): max |X(A) - fit| = %.4Le at A = %.6Lf (paper: 4.6e-5)\n", q.max_error, q.at);
-  std::snprintf(buf, sizeof buf,
-                "  \"quintic_max_error\": {\"measured\": %.6Le, \"at_A\": %.10Le, \"paper\": 4.6e-5, \"method\": \"20001-point "
-                "grid on [0, pi/2] + Brent refinement; exact X(A) by Boost TOMS 748 on A(X) in long double\"},\n",
-                q.max_error, q.at);
+  std::snprintf(
+      buf, sizeof buf,
+      "  \"quintic_max_error\": {\"measured\": %.6Le, \"at_A\": %.10Le, \"paper\": 4.6e-5, \"method\": \"20001-point "
+      "grid on [0, pi/2] + Brent refinement; exact X(A) by Boost TOMS 748 on A(X) in long double\"},\n",
+      q.max_error, q.at);
   json += buf;
   const QuinticError qr = quintic_max_error(20000, rescaled_quintic_inverse_of_A);
   std::printf("sampler's rescaled quintic (no fold, lib/warpcheck/projected_cap.h): max error %.4Le at A = %.6Lf\n",
               qr.max_error, qr.at);
-  std::snprintf(buf, sizeof buf,
-                "  \"rescaled_quintic_max_error\": {\"measured\": %.6Le, \"at_A\": %.10Le, \"kappa\": %.21Lg, \"what\": "
-                "\"the paper's g evaluated at kappa (pi/2 - |A|), kappa = e0 / (pi/2), g(pi/2 - e0) e0^(2/3) = 1: the "
-                "sampler's fit, continuous at A = 0 (ours, not the paper's)\"},\n",
-                qr.max_error, qr.at, kQuinticKappa<Real>);
+  std::snprintf(
+      buf, sizeof buf,
+      "  \"rescaled_quintic_max_error\": {\"measured\": %.6Le, \"at_A\": %.10Le, \"kappa\": %.21Lg, \"what\": "
+      "\"the paper's g evaluated at kappa (pi/2 - |A|), kappa = e0 / (pi/2), g(pi/2 - e0) e0^(2/3) = 1: the "
+      "sampler's fit, continuous at A = 0 (ours, not the paper's)\"},\n",
+      qr.max_error, qr.at, kQuinticKappa<Real>);
   json += buf;
 
   const Case3RatioStats s = case3_ratio_search<long double>(configurations, 8, 20260501);
-  std::printf("Case 3 (Alg. 4): %ld random configurations: max p/min p up to %.6f; max ratio/bound %.15f (at d/r %.6g, depth %.6g)\n"
-              "  largest ratio with |d| >= 1.094 r: %.6f (paper: <= 2); with |d| >= 2 r: %.6f (paper: <= sqrt 2 = 1.414214)\n",
-              s.configurations, s.worst_ratio, s.worst_ratio_over_bound, s.worst_d_over_r, s.worst_depth,
-              s.worst_ratio_d_ge_1_094, s.worst_ratio_d_ge_2);
-  std::snprintf(buf, sizeof buf,
-                "  \"case3_density_ratio\": {\"configurations\": %ld, \"sampling\": \"d/r log-uniform in [1+1e-6, 1e3], depth "
-                "-h/r_y uniform in (0,1), seed 20260501, density on a 9x9 grid of cut-disk points incl. corners, "
-                "long double, exact cut-disk inverse\", \"largest_ratio\": %.9g, \"largest_ratio_over_bound\": %.17g, \"at_d_over_r\": %.9g, "
-                "\"at_depth\": %.9g, \"largest_ratio_d_ge_1.094r\": %.9g, \"paper_bound_d_ge_1.094r\": 2, "
-                "\"largest_ratio_d_ge_2r\": %.9g, \"paper_bound_d_ge_2r\": 1.4142135623730951},\n",
-                s.configurations, s.worst_ratio, s.worst_ratio_over_bound, s.worst_d_over_r, s.worst_depth,
-                s.worst_ratio_d_ge_1_094, s.worst_ratio_d_ge_2);
+  std::printf(
+      "Case 3 (Alg. 4): %ld random configurations: max p/min p up to %.6f; max ratio/bound %.15f (at d/r %.6g, depth "
+      "%.6g)\n"
+      "  largest ratio with |d| >= 1.094 r: %.6f (paper: <= 2); with |d| >= 2 r: %.6f (paper: <= sqrt 2 = 1.414214)\n",
+      s.configurations, s.worst_ratio, s.worst_ratio_over_bound, s.worst_d_over_r, s.worst_depth,
+      s.worst_ratio_d_ge_1_094, s.worst_ratio_d_ge_2);
+  std::snprintf(
+      buf, sizeof buf,
+      "  \"case3_density_ratio\": {\"configurations\": %ld, \"sampling\": \"d/r log-uniform in [1+1e-6, 1e3], depth "
+      "-h/r_y uniform in (0,1), seed 20260501, density on a 9x9 grid of cut-disk points incl. corners, "
+      "long double, exact cut-disk inverse\", \"largest_ratio\": %.9g, \"largest_ratio_over_bound\": %.17g, "
+      "\"at_d_over_r\": %.9g, "
+      "\"at_depth\": %.9g, \"largest_ratio_d_ge_1.094r\": %.9g, \"paper_bound_d_ge_1.094r\": 2, "
+      "\"largest_ratio_d_ge_2r\": %.9g, \"paper_bound_d_ge_2r\": 1.4142135623730951},\n",
+      s.configurations, s.worst_ratio, s.worst_ratio_over_bound, s.worst_d_over_r, s.worst_depth,
+      s.worst_ratio_d_ge_1_094, s.worst_ratio_d_ge_2);
   json += buf;
 
   json += "  \"configurations\": [\n";
@@ -92,11 +100,13 @@ int main(int argc, char** argv) {
     const Real bias_q = mq.m1_in / phi - 1;
     std::printf("%-22s %4d %12.4Le %12.3Le %14.4Le %14.4Le %14.4Le %14.4Le\n", c.name, v.which_case, d,
                 (1.63L / d) * (1.63L / d), var_q, var_e, var_sa, bias_q);
-    std::snprintf(buf, sizeof buf,
-                  "%s    {\"config\": \"%s\", \"case\": %d, \"projected_solid_angle\": %.15Le, \"ks_round_trip_u0_D_true\": %.6Le, "
-                  "\"ks_samples_needed_1pct\": %.4Le, \"relative_variance_lambertian\": {\"quintic\": %.6Le, \"exact_inverse\": "
-                  "%.6Le, \"solid_angle_sampling\": %.6Le}, \"quintic_relative_bias_of_hits\": %.6Le}",
-                  first ? "" : ",\n", c.name, v.which_case, phi, d, (1.63L / d) * (1.63L / d), var_q, var_e, var_sa, bias_q);
+    std::snprintf(
+        buf, sizeof buf,
+        "%s    {\"config\": \"%s\", \"case\": %d, \"projected_solid_angle\": %.15Le, \"ks_round_trip_u0_D_true\": "
+        "%.6Le, "
+        "\"ks_samples_needed_1pct\": %.4Le, \"relative_variance_lambertian\": {\"quintic\": %.6Le, \"exact_inverse\": "
+        "%.6Le, \"solid_angle_sampling\": %.6Le}, \"quintic_relative_bias_of_hits\": %.6Le}",
+        first ? "" : ",\n", c.name, v.which_case, phi, d, (1.63L / d) * (1.63L / d), var_q, var_e, var_sa, bias_q);
     json += buf;
     first = false;
   }

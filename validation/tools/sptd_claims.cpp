@@ -64,10 +64,15 @@ template <class F> L integrate_mu(F&& f) {
   return sum;
 }
 L l1_distance(L gp, L g) {
-  return kTwoPi<L> * integrate_mu([&](L mu) { return std::abs(pivot_phase_function(mu, gp) - henyey_greenstein(mu, g)); });
+  return kTwoPi<L> *
+         integrate_mu([&](L mu) { return std::abs(pivot_phase_function(mu, gp) - henyey_greenstein(mu, g)); });
 }
-L mean_cosine(L gp) { return kTwoPi<L> * integrate_mu([&](L mu) { return mu * pivot_phase_function(mu, gp); }); }
-L total_mass(L gp) { return kTwoPi<L> * integrate_mu([&](L mu) { return pivot_phase_function(mu, gp); }); }
+L mean_cosine(L gp) {
+  return kTwoPi<L> * integrate_mu([&](L mu) { return mu * pivot_phase_function(mu, gp); });
+}
+L total_mass(L gp) {
+  return kTwoPi<L> * integrate_mu([&](L mu) { return pivot_phase_function(mu, gp); });
+}
 
 Vec3<L> random_unit(std::mt19937_64& r) {
   std::normal_distribution<double> n;
@@ -93,8 +98,10 @@ int main(int argc, char** argv) {
     const std::string v = argv[++i];
     if (a == "--pairs") pairs = std::atol(v.c_str());
     if (a == "--seed") seed = std::strtoul(v.c_str(), nullptr, 10);
-    if (a == "--out") out = v;
-    else command += " " + a + " " + v;
+    if (a == "--out")
+      out = v;
+    else
+      command += " " + a + " " + v;
   }
 
   // ---- 1. HG fit ----
@@ -107,15 +114,17 @@ int main(int argc, char** argv) {
   for (L g : grid) {
     const L gp = hg_to_pivot(g);
     const L d = l1_distance(gp, g);
-    const auto best = boost::math::tools::brent_find_minima([&](L x) { return l1_distance(x, g); }, L(-0.999L), L(0.999L), 40);
+    const auto best =
+        boost::math::tools::brent_find_minima([&](L x) { return l1_distance(x, g); }, L(-0.999L), L(0.999L), 40);
     worst_mass = std::max(worst_mass, double(std::abs(total_mass(gp) - 1)));
     if (double(d) > worst_fit) worst_fit = double(d), worst_fit_g = double(g);
     worst_opt = std::max(worst_opt, double(best.second));
     char b[256];
-    std::snprintf(b, sizeof b,
-                  "    {\"g\": %.2f, \"g_p\": %.6f, \"l1\": %.4e, \"mean_cosine_pivot\": %.6f, \"g_p_l1_optimal\": %.6f, "
-                  "\"l1_optimal\": %.4e}",
-                  double(g), double(gp), double(d), double(mean_cosine(gp)), double(best.first), double(best.second));
+    std::snprintf(
+        b, sizeof b,
+        "    {\"g\": %.2f, \"g_p\": %.6f, \"l1\": %.4e, \"mean_cosine_pivot\": %.6f, \"g_p_l1_optimal\": %.6f, "
+        "\"l1_optimal\": %.4e}",
+        double(g), double(gp), double(d), double(mean_cosine(gp)), double(best.first), double(best.second));
     hg_rows += (hg_rows.empty() ? "" : ",\n") + std::string(b);
   }
 
@@ -147,24 +156,29 @@ int main(int argc, char** argv) {
   j += "  \"command\": \"" + command + "\",\n";
   j += "  \"seed\": " + std::to_string(seed) + ",\n";
   j += "  \"hg_fit\": {\n";
-  j += "    \"what\": \"pivot phase function (Eq. 25) with g_p from Eqs. 27-28 vs Henyey-Greenstein (Eq. 26): L1 distance over the sphere (0 identical, 2 disjoint)\",\n";
-  j += "    \"paper\": \"no number: the fit gives 'very similar renderings' (Sec. 6.2; Fig. 15 polar plots, Fig. 16 renderings, Fig. 18 at g = 0.9)\",\n";
+  j += "    \"what\": \"pivot phase function (Eq. 25) with g_p from Eqs. 27-28 vs Henyey-Greenstein (Eq. 26): L1 "
+       "distance over the sphere (0 identical, 2 disjoint)\",\n";
+  j += "    \"paper\": \"no number: the fit gives 'very similar renderings' (Sec. 6.2; Fig. 15 polar plots, Fig. 16 "
+       "renderings, Fig. 18 at g = 0.9)\",\n";
   char b[400];
   std::snprintf(b, sizeof b,
-                "    \"max_l1\": %.4e, \"at_g\": %.2f, \"max_l1_with_optimal_g_p\": %.4e, \"max_normalisation_error_eq9\": %.3e,\n",
+                "    \"max_l1\": %.4e, \"at_g\": %.2f, \"max_l1_with_optimal_g_p\": %.4e, "
+                "\"max_normalisation_error_eq9\": %.3e,\n",
                 worst_fit, worst_fit_g, worst_opt, worst_mass);
   j += b;
   j += "    \"rows\": [\n" + hg_rows + "\n    ]\n  },\n";
   j += "  \"two_cap_eq37\": {\n";
-  j += "    \"what\": \"|Eq. 37 - Eqs. 35-36| on random partially overlapping cap pairs (axes uniform on the sphere, half-angles uniform in each regime)\",\n";
-  j += "    \"paper\": \"no number: Eq. 37 (Oat and Sander 2007) is 'an approximation of Equation (36)' used in the real-time implementation (Appendix B)\",\n";
+  j += "    \"what\": \"|Eq. 37 - Eqs. 35-36| on random partially overlapping cap pairs (axes uniform on the sphere, "
+       "half-angles uniform in each regime)\",\n";
+  j += "    \"paper\": \"no number: Eq. 37 (Oat and Sander 2007) is 'an approximation of Equation (36)' used in the "
+       "real-time implementation (Appendix B)\",\n";
   j += "    \"pairs_drawn_per_regime\": " + std::to_string(pairs) + ",\n";
   j += "    \"half_angles_up_to_180_deg\": {\"partial_overlap\": " + std::to_string(abs_err[0].size()) +
        ", \"union_covers_sphere\": " + std::to_string(covering[0]) + ", \"abs_error_sr\": " + json(stats(abs_err[0])) +
        ", \"error_relative_to_smaller_cap\": " + json(stats(rel_err[0])) + "},\n";
   j += "    \"half_angles_up_to_30_deg\": {\"partial_overlap\": " + std::to_string(abs_err[1].size()) +
-       ", \"abs_error_sr\": " + json(stats(abs_err[1])) + ", \"error_relative_to_smaller_cap\": " +
-       json(stats(rel_err[1])) + "}\n";
+       ", \"abs_error_sr\": " + json(stats(abs_err[1])) +
+       ", \"error_relative_to_smaller_cap\": " + json(stats(rel_err[1])) + "}\n";
   j += "  }\n}\n";
   std::fputs(j.c_str(), stdout);
   const std::filesystem::path parent = std::filesystem::path(out).parent_path();

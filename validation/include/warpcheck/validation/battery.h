@@ -81,8 +81,8 @@ std::string to_json(const std::vector<TestResult>& results, double alpha, Correc
                     const std::string& extra_members = "");
 
 // Convenience for a user's own GoogleTest: run the battery on one sampler and judge it at alpha.
-std::vector<TestResult> validate(const SamplerUnderTest& s, const BatteryOptions& options = {},
-                                 double alpha = 0.01, Correction c = Correction::kHolm);
+std::vector<TestResult> validate(const SamplerUnderTest& s, const BatteryOptions& options = {}, double alpha = 0.01,
+                                 Correction c = Correction::kHolm);
 
 // ---- Building blocks, exposed for tests -----------------------------------------------------------------
 
@@ -114,8 +114,8 @@ QuadratureResult integrate_cap_region_with_error(const std::function<Real(const 
                                                  Real t0, Real t1, Real phi0, Real phi1, Real tol = 1e-10L,
                                                  int azimuth_panels = 1, int radial_panels = 1,
                                                  const std::vector<Vec3L>& boundary_planes = {}, Real abs_tol = 0);
-Real integrate_cap_region(const std::function<Real(const Vec3L&)>& f, const Cap<Real>& cap, Real t0, Real t1,
-                          Real phi0, Real phi1, Real tol = 1e-10L, int azimuth_panels = 1, int radial_panels = 1,
+Real integrate_cap_region(const std::function<Real(const Vec3L&)>& f, const Cap<Real>& cap, Real t0, Real t1, Real phi0,
+                          Real phi1, Real tol = 1e-10L, int azimuth_panels = 1, int radial_panels = 1,
                           const std::vector<Vec3L>& boundary_planes = {}, Real abs_tol = 0);
 
 // The direction with coordinates (t, phi) in the cap's frame, and back.

@@ -31,9 +31,8 @@ template <class T> struct SptdCapKernel {
 // A SamplerUnderTest for an SPTD over a cap in scalar T, with the long double kernel as the reference warp.
 // Normalisation check: the kernel's integral of D over C (Eq. 10, through g(C)) against `reference`, an
 // independently computed value the caller supplies (quadrature of Eq. 8 over C); skipped when reference <= 0.
-template <class T>
-SamplerUnderTest bind_sptd_cap(const std::string& kernel, const std::string& config, const SptdCapGeometry<Real>& g,
-                               Real reference_integral = 0) {
+template <class T> SamplerUnderTest bind_sptd_cap(const std::string& kernel, const std::string& config,
+                                                  const SptdCapGeometry<Real>& g, Real reference_integral = 0) {
   SamplerUnderTest s = bind_kernel<SptdCapKernel<T>, SptdCapKernel<Real>>(kernel, config, g.template cast<T>(), g);
   s.pdf = SptdCapKernel<T>::cached_pdf(g.template cast<T>());
   if (g.sptd.base == SptdBase::kClampedCosine) {
@@ -79,7 +78,9 @@ template <class T> struct LtcKernel {
     return bounding_cap_of_directions(w.data(), n);
   }
   static std::function<Real(const Vec3L&)> cached_pdf(const Geometry& g) {
-    return [v = make_ltc_polygon_view(g)](const Vec3L& w) { return Real(pdf_ltc_polygon(v, Vec3<T>(w.template cast<T>()))); };
+    return [v = make_ltc_polygon_view(g)](const Vec3L& w) {
+      return Real(pdf_ltc_polygon(v, Vec3<T>(w.template cast<T>())));
+    };
   }
 };
 

@@ -43,10 +43,10 @@ template <class T> struct Bounds {
 enum class Goal { kMinimize, kMaximize };
 
 template <class T> struct NelderMeadOptions {
-  int max_iterations = 100;   // per local run (the paper's 100 per random initialisation)
-  T initial_step = T(0.05);   // initial simplex edge, as a fraction of each box width
-  T f_tolerance = T(0);       // stop when |f_worst - f_best| <= f_tolerance (|f_best| + tiny); 0: never
-  T x_tolerance = T(0);       // stop when all simplex edges are below x_tolerance box widths; 0: never
+  int max_iterations = 100;  // per local run (the paper's 100 per random initialisation)
+  T initial_step = T(0.05);  // initial simplex edge, as a fraction of each box width
+  T f_tolerance = T(0);      // stop when |f_worst - f_best| <= f_tolerance (|f_best| + tiny); 0: never
+  T x_tolerance = T(0);      // stop when all simplex edges are below x_tolerance box widths; 0: never
   Goal goal = Goal::kMinimize;
 };
 
@@ -120,8 +120,10 @@ LocalResult<T> nelder_mead(F&& f, const Bounds<T>& box, std::vector<T> x0, const
     if (kr < k[best]) {
       along(xe, T(2));  // expansion
       const T ke = eval(xe);
-      if (ke < kr) p[worst] = xe, k[worst] = ke;
-      else p[worst] = xr, k[worst] = kr;
+      if (ke < kr)
+        p[worst] = xe, k[worst] = ke;
+      else
+        p[worst] = xr, k[worst] = kr;
     } else if (kr < k[second]) {
       p[worst] = xr, k[worst] = kr;
     } else {
@@ -152,9 +154,9 @@ LocalResult<T> nelder_mead(F&& f, const Bounds<T>& box, std::vector<T> x0, const
 
 template <class T> struct MultiStartOptions {
   NelderMeadOptions<T> local;
-  int cheap_samples = 32;     // a chain's first start: the best of this many uniform random valid points
-  int max_cheap_tries = 4096; // give up looking for valid points after this many draws
-  int chain_length = 4;       // local runs per chain: 1 from the cheap samples, the rest around the chain's best
+  int cheap_samples = 32;      // a chain's first start: the best of this many uniform random valid points
+  int max_cheap_tries = 4096;  // give up looking for valid points after this many draws
+  int chain_length = 4;        // local runs per chain: 1 from the cheap samples, the rest around the chain's best
   // Perturbation scale of the later starts (and their initial simplex), in box widths, log-uniform. Measured
   // on 6-D Rosenbrock (test_nelder_mead): a floor of 1e-4 beats 1e-5 and 1e-7, whose tiny simplices crawl.
   T refine_scale_min = T(1e-4), refine_scale_max = T(1e-1);
@@ -178,9 +180,8 @@ inline std::uint64_t splitmix64(std::uint64_t x) {
 template <class T> bool better(T a, T b, Goal g) { return detail::key_of(a, g) < detail::key_of(b, g); }
 
 // One chain of the multi-start search: a pure function of (seed, chain).
-template <class T, class F>
-ChainResult<T> run_chain(F&& f, const Bounds<T>& box, const MultiStartOptions<T>& opt, std::uint64_t seed,
-                         std::uint64_t chain) {
+template <class T, class F> ChainResult<T> run_chain(F&& f, const Bounds<T>& box, const MultiStartOptions<T>& opt,
+                                                     std::uint64_t seed, std::uint64_t chain) {
   const Goal goal = opt.local.goal;
   std::mt19937_64 rng(splitmix64(seed ^ splitmix64(chain)));
   std::uniform_real_distribution<long double> U(0.0L, 1.0L);
@@ -220,9 +221,8 @@ ChainResult<T> run_chain(F&& f, const Bounds<T>& box, const MultiStartOptions<T>
 }
 
 // Convenience: chains 0 .. chains-1 in sequence, the best of them.
-template <class T, class F>
-ChainResult<T> multi_start(F&& f, const Bounds<T>& box, const MultiStartOptions<T>& opt, std::uint64_t seed,
-                           int chains) {
+template <class T, class F> ChainResult<T> multi_start(F&& f, const Bounds<T>& box, const MultiStartOptions<T>& opt,
+                                                       std::uint64_t seed, int chains) {
   ChainResult<T> best;
   for (int c = 0; c < chains; ++c) {
     ChainResult<T> r = run_chain(f, box, opt, seed, std::uint64_t(c));

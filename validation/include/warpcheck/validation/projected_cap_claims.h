@@ -1,12 +1,13 @@
 // warpcheck/validation/projected_cap_claims.h: measurements of the claims of Peters & Dachsbacher 2019 (projected
-// spherical caps), shared by validation/tests/{test,slow}_projected_cap.cpp and validation/tools/projected_cap_claims.cpp.
-// Each function measures one claim independently of the code path it checks (see each comment).
+// spherical caps), shared by validation/tests/{test,slow}_projected_cap.cpp and
+// validation/tools/projected_cap_claims.cpp. Each function measures one claim independently of the code path it checks
+// (see each comment).
 #pragma once
 
+#include <algorithm>
 #include <boost/math/distributions/kolmogorov_smirnov.hpp>
 #include <boost/math/tools/minima.hpp>
 #include <boost/math/tools/roots.hpp>
-#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <random>
@@ -40,7 +41,8 @@ inline Real exact_inverse_of_A(Real a) {
   if (a >= kPi<Real> / 2) return 1;
   auto f = [a](Real x) { return x * std::sqrt((1 - x) * (1 + x)) + std::asin(x) - a; };
   std::uintmax_t it = 200;
-  const auto r = boost::math::tools::toms748_solve(f, Real(0), Real(1), boost::math::tools::eps_tolerance<Real>(64), it);
+  const auto r =
+      boost::math::tools::toms748_solve(f, Real(0), Real(1), boost::math::tools::eps_tolerance<Real>(64), it);
   return (r.first + r.second) / 2;
 }
 
@@ -144,9 +146,11 @@ template <class T> Case3RatioStats case3_ratio_search(long count, int grid, std:
     // rounding (~3e-16) to long double's, which is what made the earlier allowance miss by 4.4e-16.
     const T ratio_t = case3_density_ratio(p, grid), excess_t = ratio_t / case3_bound(p) - T(1);
     const double ratio = double(ratio_t), rb = 1 + double(excess_t);
-    s.worst_excess_over_rounding = std::max(s.worst_excess_over_rounding, double(excess_t) - case3_rounding_allowance<T>(p));
+    s.worst_excess_over_rounding =
+        std::max(s.worst_excess_over_rounding, double(excess_t) - case3_rounding_allowance<T>(p));
     s.worst_excess = std::max(s.worst_excess, double(excess_t));
-    if (rb > s.worst_ratio_over_bound) s.worst_ratio_over_bound = rb, s.worst_d_over_r = d_over_r, s.worst_depth = depth;
+    if (rb > s.worst_ratio_over_bound)
+      s.worst_ratio_over_bound = rb, s.worst_d_over_r = d_over_r, s.worst_depth = depth;
     s.worst_ratio = std::max(s.worst_ratio, ratio);
     if (d_over_r >= 1.094) s.worst_ratio_d_ge_1_094 = std::max(s.worst_ratio_d_ge_1_094, ratio);
     if (d_over_r >= 2) s.worst_ratio_d_ge_2 = std::max(s.worst_ratio_d_ge_2, ratio);
@@ -164,8 +168,9 @@ struct RoundTrip {
 // max |invert(sample(u)) - u| in double over n random u, skipping u0 within 1e-4 of the kinks of
 // projected_cap_bands (the Case-2 threshold).
 template <CutDiskInverse M> RoundTrip round_trip(const SphereLightGeometry<Real>& gl, int n, std::uint64_t seed) {
-  const SphereLightGeometry<double> g{ShadingPoint<double>{gl.shading.position.cast<double>(), gl.shading.normal.cast<double>()},
-                                      SphereLight<double>{gl.light.center.cast<double>(), double(gl.light.radius)}};
+  const SphereLightGeometry<double> g{
+      ShadingPoint<double>{gl.shading.position.cast<double>(), gl.shading.normal.cast<double>()},
+      SphereLight<double>{gl.light.center.cast<double>(), double(gl.light.radius)}};
   const ProjectedCapView<double> v = make_projected_cap_view(g);
   const auto bands = projected_cap_bands<M>(gl);
   std::mt19937_64 rng(seed);
@@ -215,8 +220,9 @@ struct KsResult {
 // KS test of u0' (above) for n samples of the double kernel at a fixed seed, against the uniform distribution;
 // p from boost::math::kolmogorov_smirnov_distribution (the limiting form, applied to D).
 inline KsResult ks_round_trip_u0(const SphereLightGeometry<Real>& g, std::size_t n, std::uint64_t seed) {
-  const SphereLightGeometry<double> gd{ShadingPoint<double>{g.shading.position.cast<double>(), g.shading.normal.cast<double>()},
-                                       SphereLight<double>{g.light.center.cast<double>(), double(g.light.radius)}};
+  const SphereLightGeometry<double> gd{
+      ShadingPoint<double>{g.shading.position.cast<double>(), g.shading.normal.cast<double>()},
+      SphereLight<double>{g.light.center.cast<double>(), double(g.light.radius)}};
   const ProjectedCapView<double> vd = make_projected_cap_view(gd);
   const ProjectedCapView<Real> vl = make_projected_cap_view(g);
   std::mt19937_64 rng(seed);
@@ -231,8 +237,7 @@ inline KsResult ks_round_trip_u0(const SphereLightGeometry<Real>& g, std::size_t
   }
   std::sort(x.begin(), x.end());
   double d = 0;
-  for (std::size_t i = 0; i < n; ++i)
-    d = std::max({d, double(i + 1) / double(n) - x[i], x[i] - double(i) / double(n)});
+  for (std::size_t i = 0; i < n; ++i) d = std::max({d, double(i + 1) / double(n) - x[i], x[i] - double(i) / double(n)});
   KsResult r;
   r.d = d;
   r.p_value = double(cdf(complement(boost::math::kolmogorov_smirnov_distribution<double>(double(n)), d)));

@@ -17,7 +17,8 @@ struct ProjectedCapConfig {
   SphereLightGeometry<Real> g;
 };
 
-// Cases 1-4, their boundaries, grazing, near-touching, tiny and huge lights (validation/src/registry_projected_cap.cpp).
+// Cases 1-4, their boundaries, grazing, near-touching, tiny and huge lights
+// (validation/src/registry_projected_cap.cpp).
 std::vector<ProjectedCapConfig> projected_cap_configs();
 
 // Projected solid angle of the light by long double adaptive quadrature of max(0, n.w) over its cap:
@@ -28,8 +29,7 @@ Real reference_projected_solid_angle(const SphereLightGeometry<Real>& g, Real to
 template <CutDiskInverse M> std::vector<Real> projected_cap_kinks(const SphereLightGeometry<Real>& g);
 // The u0 intervals behind those kinks: (tau, tau) for the Case-2 threshold, and (lo, hi) for each band where
 // the quintic's warp reaches directions twice (fold, seam).
-template <CutDiskInverse M>
-std::vector<std::pair<Real, Real>> projected_cap_bands(const SphereLightGeometry<Real>& g);
+template <CutDiskInverse M> std::vector<std::pair<Real, Real>> projected_cap_bands(const SphereLightGeometry<Real>& g);
 // Integral of max(0, n.w)^power (power 1: the projected solid angle) over the light's cap, by rings around the
 // cap's axis in closed form and long double Gauss-Kronrod across the rings.
 Real cap_cosine_moment(const SphereLightGeometry<Real>& g, int power);

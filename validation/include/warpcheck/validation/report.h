@@ -32,7 +32,7 @@ struct Result {
   std::optional<double> p_value;    // null for deterministic tests
   bool passed = false;
   std::string detail, known_limitation;
-  int map_rows = 0, map_cols = 0;   // chi2 only: the grid over the bounding cap (battery.h TestResult)
+  int map_rows = 0, map_cols = 0;  // chi2 only: the grid over the bounding cap (battery.h TestResult)
   std::vector<double> observed, expected;
 
   // Failed and not a documented limitation: this fails the run.
@@ -119,9 +119,9 @@ std::string svg_line_plot(const std::vector<Series>& series, const std::string& 
 // ---- The site ----------------------------------------------------------------------------------------------------
 
 struct ReportOptions {
-  std::string out_dir;       // created if missing
-  std::string results_path;  // battery JSON (required)
-  std::string data_dir;      // claims, worst cases, fuzz, bench; empty: no data sections read
+  std::string out_dir;              // created if missing
+  std::string results_path;         // battery JSON (required)
+  std::string data_dir;             // claims, worst cases, fuzz, bench; empty: no data sections read
   int sample_cases_per_kernel = 3;  // registry cases drawn as sample sets per kernel
   int grid_lines = 17, grid_line_samples = 96, blue_noise_points = 1024;
 };

@@ -39,9 +39,9 @@ struct Sample {
 // An independently computed measure that the sampler's normalisation must equal (e.g. the cap's solid angle
 // for a uniform cone sampler, the projected solid angle for a projected-solid-angle sampler).
 struct Normalization {
-  std::string what;                  // e.g. "solid angle of the cap"
-  std::function<Real()> kernel;      // the value the kernel's own code uses (e.g. 1 / pdf)
-  Real reference = 0;                // computed independently of the kernel's code
+  std::string what;              // e.g. "solid angle of the cap"
+  std::function<Real()> kernel;  // the value the kernel's own code uses (e.g. 1 / pdf)
+  Real reference = 0;            // computed independently of the kernel's code
 };
 
 struct SamplerUnderTest {
@@ -80,8 +80,7 @@ struct SamplerUnderTest {
 // ---- Kernel concept: for samplers written as warpcheck-style kernels ---------------------------------------
 
 template <class K>
-concept Kernel = requires(const typename K::Geometry& g, typename K::Scalar u,
-                          const Vec3<typename K::Scalar>& w) {
+concept Kernel = requires(const typename K::Geometry& g, typename K::Scalar u, const Vec3<typename K::Scalar>& w) {
   typename K::Scalar;
   typename K::Geometry;
   { K::sample(g, Vec2<typename K::Scalar>(u, u)) } -> std::convertible_to<DirectionSample<typename K::Scalar>>;
@@ -92,10 +91,14 @@ concept Kernel = requires(const typename K::Geometry& g, typename K::Scalar u,
 template <class T> Vec3L to_long(const Vec3<T>& v) { return v.template cast<Real>(); }
 
 template <class T> constexpr const char* scalar_name() {
-  if constexpr (std::is_same_v<T, float>) return "float";
-  else if constexpr (std::is_same_v<T, double>) return "double";
-  else if constexpr (std::is_same_v<T, long double>) return "long double";
-  else return "custom";
+  if constexpr (std::is_same_v<T, float>)
+    return "float";
+  else if constexpr (std::is_same_v<T, double>)
+    return "double";
+  else if constexpr (std::is_same_v<T, long double>)
+    return "long double";
+  else
+    return "custom";
 }
 
 // A uniform number in [0, 1) as T: rounding to float can turn 1 - 2^-53 into 1, which some warps map onto a
@@ -110,8 +113,8 @@ template <class T> Sample to_sample(const DirectionSample<T>& s) {
 }
 
 // Binds kernel K to geometry g. The geometry is converted to K's scalar type by the caller.
-template <Kernel K> SamplerUnderTest bind_kernel(std::string kernel, std::string config,
-                                                 const typename K::Geometry& g) {
+template <Kernel K>
+SamplerUnderTest bind_kernel(std::string kernel, std::string config, const typename K::Geometry& g) {
   using T = typename K::Scalar;
   SamplerUnderTest s;
   s.kernel = std::move(kernel);
@@ -125,9 +128,9 @@ template <Kernel K> SamplerUnderTest bind_kernel(std::string kernel, std::string
 }
 
 // As above, with KRef (the same kernel in long double, on the same geometry converted) as the reference warp.
-template <Kernel K, Kernel KRef>
-SamplerUnderTest bind_kernel(std::string kernel, std::string config, const typename K::Geometry& g,
-                             const typename KRef::Geometry& g_ref) {
+template <Kernel K, Kernel KRef> SamplerUnderTest bind_kernel(std::string kernel, std::string config,
+                                                              const typename K::Geometry& g,
+                                                              const typename KRef::Geometry& g_ref) {
   SamplerUnderTest s = bind_kernel<K>(std::move(kernel), std::move(config), g);
   s.reference_sample = [g_ref](Real u0, Real u1) {
     using R = typename KRef::Scalar;

@@ -71,17 +71,17 @@ struct SearchRecord {
   std::uint64_t shard_index = 0, shard_count = 1;
   std::vector<long double> best_x;  // empty until some chain found a valid point
   long double best_f = std::numeric_limits<long double>::quiet_NaN();
-  std::uint64_t best_chain = 0;      // global chain index that found best_x
-  long long evaluations = 0;         // objective evaluations spent (over all resumes)
-  std::uint64_t chains = 0;          // chains completed
-  std::uint64_t next_local = 0;      // every local chain index below this is done
+  std::uint64_t best_chain = 0;           // global chain index that found best_x
+  long long evaluations = 0;              // objective evaluations spent (over all resumes)
+  std::uint64_t chains = 0;               // chains completed
+  std::uint64_t next_local = 0;           // every local chain index below this is done
   std::vector<std::uint64_t> done_above;  // completed local indices >= next_local (out of order, threads)
-  double seconds = 0;                // wall-clock seconds spent (over all resumes)
-  double target_seconds = 0;         // the budget the run was started with
-  std::string kernel_version;        // `git describe --always --dirty` of the tree that ran it
-  std::string command;               // the command line that produced it
-  std::vector<std::string> merged_from;  // for merged records: the files they came from
-  std::vector<HistoryPoint> history; // every improvement of best_f, in order (the last one is best_f)
+  double seconds = 0;                     // wall-clock seconds spent (over all resumes)
+  double target_seconds = 0;              // the budget the run was started with
+  std::string kernel_version;             // `git describe --always --dirty` of the tree that ran it
+  std::string command;                    // the command line that produced it
+  std::vector<std::string> merged_from;   // for merged records: the files they came from
+  std::vector<HistoryPoint> history;      // every improvement of best_f, in order (the last one is best_f)
 
   std::uint64_t global_chain(std::uint64_t local) const { return local * shard_count + shard_index; }
 };
@@ -117,7 +117,7 @@ void append_cap_searches(std::vector<Search>& v);     // searches_caps.cpp: proj
 // `git describe --always --dirty` of the source tree, or "unknown" without git.
 std::string source_version();
 
-std::string hex(long double v);    // "%La"
+std::string hex(long double v);              // "%La"
 long double from_hex(const std::string& s);  // strtold; throws on garbage
 
 }  // namespace warpcheck::validation
