@@ -7,7 +7,7 @@ ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD_DIR="${BUILD_DIR:-$ROOT/build}"
 
 PACKAGES=(cmake ninja-build g++ libboost1.81-dev libeigen3-dev libopenexr-dev libgtest-dev libbenchmark-dev
-          clang libclang-rt-14-dev libpng-dev chromium)
+          clang clang-format libclang-rt-14-dev libpng-dev chromium)
 
 missing=()
 for p in "${PACKAGES[@]}"; do
