@@ -2,7 +2,7 @@
 #include <cstdio>
 
 #include "commands.h"
-#include "warpcheck/validation/report.h"
+#include "report.h"
 
 namespace warpcheck::cli {
 

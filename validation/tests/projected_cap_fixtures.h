@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "warpcheck/validation/projected_cap_claims.h"
+#include "tools/projected_cap_claims.h"
 
 namespace warpcheck::validation::projected_cap_test {
 

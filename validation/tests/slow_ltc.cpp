@@ -1,9 +1,9 @@
 // The battery on LTC sampling of a polygon (Peters 2021 Sec. 4.1) for a random and an ill-conditioned M.
 #include <gtest/gtest.h>
 
+#include "catalogue/kernels_sptd.h"
 #include "ltc_fixtures.h"
 #include "warpcheck/validation/battery.h"
-#include "warpcheck/validation/kernels_sptd.h"
 #include "warpcheck/validation/registry.h"
 
 namespace warpcheck {

@@ -4,9 +4,9 @@
 // the samplers' densities sample by sample.
 #include <gtest/gtest.h>
 
+#include "catalogue/kernels_sptd.h"
 #include "warpcheck/sptd.h"
 #include "warpcheck/validation/battery.h"
-#include "warpcheck/validation/kernels_sptd.h"
 
 namespace warpcheck {
 namespace {

@@ -10,10 +10,10 @@
 #include <limits>
 #include <random>
 
+#include "catalogue/kernels_sptd.h"
 #include "ltc_fixtures.h"
 #include "warpcheck/mis.h"
 #include "warpcheck/validation/battery.h"
-#include "warpcheck/validation/kernels_sptd.h"
 
 namespace warpcheck {
 namespace {

@@ -18,10 +18,10 @@
 #include <set>
 #include <sstream>
 
+#include "report.h"
 #include "warpcheck/validation/battery.h"
 #include "warpcheck/validation/negative_controls.h"
 #include "warpcheck/validation/registry.h"
-#include "warpcheck/validation/report.h"
 
 namespace fs = std::filesystem;
 using namespace warpcheck::validation;

@@ -10,9 +10,9 @@
 #include <boost/math/quadrature/gauss_kronrod.hpp>
 
 #include "autodiff_eigen.h"
+#include "catalogue/kernels_sptd.h"
 #include "warpcheck/sptd.h"
 #include "warpcheck/validation/battery.h"
-#include "warpcheck/validation/kernels_sptd.h"
 
 namespace warpcheck {
 namespace {

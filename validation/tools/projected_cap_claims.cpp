@@ -17,7 +17,7 @@
 #include <fstream>
 #include <string>
 
-#include "warpcheck/validation/projected_cap_claims.h"
+#include "tools/projected_cap_claims.h"
 
 using namespace warpcheck;
 using namespace warpcheck::validation;

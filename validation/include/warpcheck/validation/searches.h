@@ -111,8 +111,9 @@ void run_search(const Search& s, SearchRecord& state, const RunOptions& o);
 SearchRecord merge_records(const std::vector<SearchRecord>& records);
 
 // Search families defined in other files of validation/src (called by all_searches()).
-void append_kernel_searches(std::vector<Search>& v);  // searches_kernels.cpp: precision and pdf vs warp
-void append_cap_searches(std::vector<Search>& v);     // searches_caps.cpp: projected caps, SPTD caps
+void append_polygon_searches(std::vector<Search>& v);  // polygon.cpp: Peters 2021 backward errors
+void append_kernel_searches(std::vector<Search>& v);   // kernels.cpp: precision and pdf vs warp
+void append_cap_searches(std::vector<Search>& v);      // caps.cpp: projected caps, SPTD caps
 
 // `git describe --always --dirty` of the source tree, or "unknown" without git.
 std::string source_version();

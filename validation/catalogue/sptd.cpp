@@ -6,8 +6,8 @@
 #include <cmath>
 #include <limits>
 
+#include "catalogue/kernels_sptd.h"
 #include "warpcheck/sptd.h"
-#include "warpcheck/validation/kernels_sptd.h"
 #include "warpcheck/validation/registry.h"
 
 namespace warpcheck::validation {

@@ -9,8 +9,8 @@
 #include <boost/math/quadrature/tanh_sinh.hpp>
 #include <cmath>
 
+#include "catalogue/projected_cap_configs.h"
 #include "warpcheck/projected_cap.h"
-#include "warpcheck/validation/projected_cap_configs.h"
 #include "warpcheck/validation/registry.h"
 
 namespace warpcheck::validation {

@@ -10,11 +10,11 @@
 #include <set>
 #include <sstream>
 
+#include "report.h"
+#include "tools/projected_cap_claims.h"
 #include "warpcheck/polygon_error_analysis.h"
 #include "warpcheck/validation/negative_controls.h"
-#include "warpcheck/validation/projected_cap_claims.h"
 #include "warpcheck/validation/registry.h"
-#include "warpcheck/validation/report.h"
 
 namespace warpcheck::validation::report {
 namespace fs = std::filesystem;

@@ -5,7 +5,7 @@
 #include <limits>
 #include <stdexcept>
 
-#include "warpcheck/validation/report.h"
+#include "report.h"
 
 namespace warpcheck::validation::report {
 namespace {

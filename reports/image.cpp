@@ -14,7 +14,7 @@
 #include <cstdio>
 #include <stdexcept>
 
-#include "warpcheck/validation/report.h"
+#include "report.h"
 
 namespace warpcheck::validation::report {
 namespace {

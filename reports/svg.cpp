@@ -11,8 +11,8 @@
 #include <random>
 #include <sstream>
 
+#include "report.h"
 #include "warpcheck/validation/battery.h"
-#include "warpcheck/validation/report.h"
 
 namespace warpcheck::validation::report {
 namespace {

@@ -15,8 +15,8 @@
 #include <string>
 #include <vector>
 
+#include "catalogue/projected_cap_configs.h"
 #include "warpcheck/projected_cap.h"
-#include "warpcheck/validation/projected_cap_configs.h"
 #include "warpcheck/validation/registry.h"
 
 namespace warpcheck::validation::projected_cap_test {
