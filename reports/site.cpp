@@ -5,14 +5,12 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
-#include <random>
 #include <set>
 #include <sstream>
 
 #include "report.h"
-#include "tools/projected_cap_claims.h"
-#include "warpcheck/polygon_error_analysis.h"
 #include "warpcheck/validation/negative_controls.h"
 #include "warpcheck/validation/registry.h"
 
@@ -452,22 +450,24 @@ std::string claims_section(const fs::path& data) {
   return o.str();
 }
 
+bool as_number(const json::value& n, double& out) {
+  if (n.is_double()) return out = n.get_double(), true;
+  if (n.is_int64()) return out = double(n.get_int64()), true;
+  if (n.is_uint64()) return out = double(n.get_uint64()), true;
+  return false;
+}
+
 // x, y of one history entry: an [x, y] array or an object with a count/time and an error member.
 bool history_point(const json::value& v, double& x, double& y) {
-  auto as_num = [](const json::value& n, double& out) {
-    if (n.is_double()) return out = n.get_double(), true;
-    if (n.is_int64()) return out = double(n.get_int64()), true;
-    if (n.is_uint64()) return out = double(n.get_uint64()), true;
-    return false;
-  };
-  if (v.is_array() && v.get_array().size() >= 2) return as_num(v.get_array()[0], x) && as_num(v.get_array()[1], y);
+  if (v.is_array() && v.get_array().size() >= 2)
+    return as_number(v.get_array()[0], x) && as_number(v.get_array()[1], y);
   if (!v.is_object()) return false;
   const auto& o = v.get_object();
   bool hx = false, hy = false;
   for (const char* k : {"evaluations", "seconds", "chain", "index"})
-    if (!hx && o.if_contains(k)) hx = as_num(o.at(k), x);
+    if (!hx && o.if_contains(k)) hx = as_number(o.at(k), x);
   for (const char* k : {"best", "worst_error", "error", "value", "best_error"})
-    if (!hy && o.if_contains(k)) hy = as_num(o.at(k), y);
+    if (!hy && o.if_contains(k)) hy = as_number(o.at(k), y);
   return hx && hy;
 }
 
@@ -600,117 +600,181 @@ std::string bench_section(const fs::path& data) {
   return o.str();
 }
 
-// The polygon backward error (Peters 2021 Sec. 3.6, Eq. 7) over sector geometry: random decentral sector cases
-// (polygon_error_analysis.h's distribution, fixed seed), placed by the sector's opening angle and the target's
-// position xi within the sector, coloured by log10 of the backward error after k iterations.
-std::string polygon_backward_error_map(int iterations, int cases) {
-  std::mt19937_64 rng(1);
-  struct P {
-    double angle, xi, err;
-  };
-  std::vector<P> pts;
-  for (int i = 0; i < cases; ++i) {
-    const RandomSectorCase<double> c = random_decentral_case<double>(rng, 1e-2);
-    const double angle = std::atan2(kahan_cross2(c.sector.s0, c.sector.s1), c.sector.s0.dot(c.sector.s1)) * 180 / M_PI;
-    pts.push_back({angle, c.target / c.sector.area, decentral_backward_error<double>(c, iterations)});
-  }
-  const double lo = -17, hi = 0;  // log10 colour range: double's rounding up to a whole-sector error
-  const double W = 520, H = 300, L = 50, R = W - 70, T = 24, B = H - 36;
+// ---- maps over geometry: data/polygon/geometry-map.json and data/projected-cap/geometry-map.json, measured by
+// build/geometry_maps (validation/tools/geometry_maps.cpp); drawn here, never computed.
+
+const json::value& member(const json::object& o, const char* key) {
+  const json::value* v = o.if_contains(key);
+  if (!v) throw std::runtime_error(std::string("no member \"") + key + "\"");
+  return *v;
+}
+
+double number_of(const json::value& v, const std::string& what) {
+  double x;
+  if (!as_number(v, x)) throw std::runtime_error(what + " is not a number");
+  return x;
+}
+
+// A JSON array of numbers; null reads as NaN (no value there).
+std::vector<double> numbers_of(const json::value& v, const std::string& what) {
+  if (!v.is_array()) throw std::runtime_error(what + " is not an array");
+  std::vector<double> out;
+  for (const json::value& x : v.get_array())
+    out.push_back(x.is_null() ? std::numeric_limits<double>::quiet_NaN() : number_of(x, what + " entry"));
+  return out;
+}
+
+std::string string_of(const json::value& v, const std::string& what) {
+  if (!v.is_string()) throw std::runtime_error(what + " is not a string");
+  return std::string(v.get_string());
+}
+
+std::string rgb(const Rgb& c) {
+  return "rgb(" + std::to_string(int(c[0])) + "," + std::to_string(int(c[1])) + "," + std::to_string(int(c[2])) + ")";
+}
+
+// The plot frame shared by both maps: 520 x 300, plot area [L, R] x [T, B], a vertical colour bar right of it.
+struct Frame {
+  static constexpr double W = 520, H = 300, L = 50, R = W - 70, T = 24, B = H - 36;
+};
+
+std::string svg_frame_start(const std::string& title, const std::string& heading) {
   std::ostringstream o;
-  o << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << W << "\" height=\"" << H << "\" role=\"img\"><title>"
-    << "polygon backward error, " << iterations << " iterations</title><text x=\"6\" y=\"15\" font-size=\"12\">"
-    << "backward error |A_delta| / sector area after " << iterations << " iteration(s), double, " << cases
-    << " random decentral sectors (seed 1)</text><rect x=\"" << L << "\" y=\"" << T << "\" width=\"" << R - L
-    << "\" height=\"" << B - T << "\" fill=\"#fff\" stroke=\"#444\"/>";
-  double worst = 0;
-  for (const P& p : pts) {
-    const double l = p.err > 0 ? std::log10(p.err) : lo;
-    worst = std::max(worst, p.err);
-    const Rgb c = sequential_color((std::clamp(l, lo, hi) - lo) / (hi - lo));
-    o << "<circle cx=\"" << L + p.angle / 180 * (R - L) << "\" cy=\"" << B - p.xi * (B - T)
-      << "\" r=\"1.8\" fill=\"rgb(" << int(c[0]) << "," << int(c[1]) << "," << int(c[2]) << ")\"/>";
-  }
-  for (int k = 0; k <= 4; ++k)
-    o << "<text x=\"" << L + (R - L) * k / 4 << "\" y=\"" << B + 13 << "\" font-size=\"10\" text-anchor=\"middle\">"
-      << 45 * k << "</text><text x=\"" << L - 4 << "\" y=\"" << B - (B - T) * k / 4 + 3
-      << "\" font-size=\"10\" text-anchor=\"end\">" << k / 4.0 << "</text>";
-  o << "<text x=\"" << (L + R) / 2 << "\" y=\"" << H - 6
-    << "\" font-size=\"11\" text-anchor=\"middle\">sector "
-       "opening angle (degrees)</text><text x=\"12\" y=\""
-    << (T + B) / 2
-    << "\" font-size=\"11\" "
-       "text-anchor=\"middle\" transform=\"rotate(-90 12 "
-    << (T + B) / 2 << ")\">xi (target / sector area)</text>";
-  for (int k = 0; k <= 8; ++k) {  // colour bar
-    const Rgb c = sequential_color(k / 8.0);
-    o << "<rect x=\"" << R + 12 << "\" y=\"" << B - (B - T) * (k + 1) / 9.0 << "\" width=\"14\" height=\""
-      << (B - T) / 9.0 + 0.5 << "\" fill=\"rgb(" << int(c[0]) << "," << int(c[1]) << "," << int(c[2]) << ")\"/>";
-  }
-  o << "<text x=\"" << R + 30 << "\" y=\"" << B << "\" font-size=\"10\">1e" << lo << "</text><text x=\"" << R + 30
-    << "\" y=\"" << T + 8 << "\" font-size=\"10\">1e" << hi << "</text></svg><p class=\"muted\">Largest of these "
-    << cases << ": " << num(worst) << ".</p>";
+  o << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << Frame::W << "\" height=\"" << Frame::H
+    << "\" role=\"img\"><title>" << title << "</title><text x=\"6\" y=\"15\" font-size=\"12\">" << heading
+    << "</text><rect x=\"" << Frame::L << "\" y=\"" << Frame::T << "\" width=\"" << Frame::R - Frame::L
+    << "\" height=\"" << Frame::B - Frame::T << "\" fill=\"#fff\" stroke=\"#444\"/>";
   return o.str();
 }
 
+// Axis labels and the sequential colour bar labelled lo_label (bottom) to hi_label (top); closes the SVG.
+std::string svg_frame_end(const std::string& xlabel, const std::string& ylabel, const std::string& lo_label,
+                          const std::string& hi_label) {
+  const double L = Frame::L, R = Frame::R, T = Frame::T, B = Frame::B;
+  std::ostringstream o;
+  o << "<text x=\"" << (L + R) / 2 << "\" y=\"" << Frame::H - 6 << "\" font-size=\"11\" text-anchor=\"middle\">"
+    << xlabel << "</text><text x=\"12\" y=\"" << (T + B) / 2
+    << "\" font-size=\"11\" text-anchor=\"middle\" transform=\"rotate(-90 12 " << (T + B) / 2 << ")\">" << ylabel
+    << "</text>";
+  for (int k = 0; k <= 8; ++k)
+    o << "<rect x=\"" << R + 12 << "\" y=\"" << B - (B - T) * (k + 1) / 9.0 << "\" width=\"14\" height=\""
+      << (B - T) / 9.0 + 0.5 << "\" fill=\"" << rgb(sequential_color(k / 8.0)) << "\"/>";
+  o << "<text x=\"" << R + 30 << "\" y=\"" << B << "\" font-size=\"10\">" << lo_label << "</text><text x=\"" << R + 30
+    << "\" y=\"" << T + 8 << "\" font-size=\"10\">" << hi_label << "</text></svg>";
+  return o.str();
+}
+
+// The polygon backward error (Peters 2021 Sec. 3.6, Eq. 7) over sector geometry, one map per recorded iteration
+// count: each case placed by its sector's opening angle and the target's position xi within the sector, coloured
+// by log10 of its backward error.
+std::string polygon_backward_error_maps(const json::object& m) {
+  const std::vector<double> angle = numbers_of(member(m, "opening_angle_degrees"), "opening_angle_degrees"),
+                            xi = numbers_of(member(m, "xi"), "xi");
+  const std::string scalar = string_of(member(m, "scalar"), "scalar");
+  const long long cases = (long long)number_of(member(m, "cases"), "cases"),
+                  seed = (long long)number_of(member(m, "seed"), "seed");
+  const json::value& errors = member(m, "backward_error");
+  if (!errors.is_array()) throw std::runtime_error("backward_error is not an array");
+  const double lo = -17, hi = 0;  // log10 colour range: double's rounding up to a whole-sector error
+  const double L = Frame::L, R = Frame::R, T = Frame::T, B = Frame::B;
+  std::string out;
+  for (const json::value& e : errors.get_array()) {
+    if (!e.is_object()) throw std::runtime_error("backward_error entry is not an object");
+    const long long iterations = (long long)number_of(member(e.get_object(), "iterations"), "iterations");
+    const std::vector<double> err = numbers_of(member(e.get_object(), "values"), "backward_error values");
+    if (angle.size() != std::size_t(cases) || xi.size() != angle.size() || err.size() != angle.size())
+      throw std::runtime_error("opening_angle_degrees, xi and values do not all hold one entry per case");
+    std::ostringstream o;
+    o << svg_frame_start("polygon backward error, " + std::to_string(iterations) + " iterations",
+                         "backward error |A_delta| / sector area after " + std::to_string(iterations) +
+                             " iteration(s), " + html_escape(scalar) + ", " + std::to_string(cases) +
+                             " random decentral sectors (seed " + std::to_string(seed) + ")");
+    double worst = 0;
+    for (std::size_t i = 0; i < err.size(); ++i) {
+      const double l = err[i] > 0 ? std::log10(err[i]) : lo;
+      worst = std::max(worst, err[i]);
+      o << "<circle cx=\"" << L + angle[i] / 180 * (R - L) << "\" cy=\"" << B - xi[i] * (B - T)
+        << "\" r=\"1.8\" fill=\"" << rgb(sequential_color((std::clamp(l, lo, hi) - lo) / (hi - lo))) << "\"/>";
+    }
+    for (int k = 0; k <= 4; ++k)
+      o << "<text x=\"" << L + (R - L) * k / 4 << "\" y=\"" << B + 13 << "\" font-size=\"10\" text-anchor=\"middle\">"
+        << 45 * k << "</text><text x=\"" << L - 4 << "\" y=\"" << B - (B - T) * k / 4 + 3
+        << "\" font-size=\"10\" text-anchor=\"end\">" << k / 4.0 << "</text>";
+    o << svg_frame_end("sector opening angle (degrees)", "xi (target / sector area)", "1e" + num(lo), "1e" + num(hi))
+      << "<p class=\"muted\">Largest of these " << cases << ": " << num(worst) << ".</p>";
+    out += o.str();
+  }
+  return out;
+}
+
 // The Case-3 density ratio (Peters & Dachsbacher 2019 Sec. 3.5: max / min of Alg. 4's density over the cut disk)
-// over the geometry of Case 3: unit sphere, distance d / r on a log axis from 1.001 to 1000, centre depth below the
-// horizon as a fraction of r_y (0: centre on the horizon, 1: Case 4). Colour: the ratio divided by the paper's
-// bound (case3_bound), which must stay <= 1; the title gives the ratio's range. Long double, 9 x 9 cut-disk grid.
-std::string case3_ratio_map(int nx, int ny) {
-  using namespace projected_cap_test;
-  const double W = 520, H = 300, L = 50, R = W - 70, T = 24, B = H - 36;
+// on a grid over distance d / r (log axis) and the centre's depth below the horizon / r_y (0: on the horizon,
+// 1: Case 4); cells that are not Case 3 are null. Colour: log2 of the ratio over [0, 1] (ratio 1 to 2), the
+// bound's range for d >= 1.094 r; the caption gives the largest ratio / the paper's bound, which must stay <= 1.
+std::string case3_ratio_map(const json::object& m) {
+  const long long nx = (long long)number_of(member(m, "nx"), "nx"), ny = (long long)number_of(member(m, "ny"), "ny");
+  const std::vector<double> xr = numbers_of(member(m, "log10_distance_range"), "log10_distance_range"),
+                            yr = numbers_of(member(m, "depth_range"), "depth_range");
+  const json::value &ratios = member(m, "ratio"), &bounds = member(m, "bound");
+  if (nx < 1 || ny < 1 || xr.size() != 2 || yr.size() != 2 || !ratios.is_array() || !bounds.is_array() ||
+      ratios.get_array().size() != std::size_t(nx) || bounds.get_array().size() != std::size_t(nx))
+    throw std::runtime_error("nx, ny, the ranges and the ratio / bound rows do not agree");
+  const double L = Frame::L, R = Frame::R, T = Frame::T, B = Frame::B, cw = (R - L) / nx, ch = (B - T) / ny;
   std::ostringstream dots;
   double worst_over_bound = 0, lo_ratio = 1e300, hi_ratio = 0;
-  const double cw = (R - L) / nx, ch = (B - T) / ny;
-  for (int i = 0; i < nx; ++i)
-    for (int j = 0; j < ny; ++j) {
-      const double log_d = std::log10(1.001) + (3 - std::log10(1.001)) * (i + 0.5) / nx, depth = (j + 0.5) / ny;
-      const long double ry = 1 / std::pow(10.0L, log_d), h = -depth * ry;
-      const ProjectedCapView<long double> p = make_projected_cap_view(unit_geometry<long double>(h, ry));
-      if (!p.valid() || p.which_case != 3) continue;
-      const double ratio = double(case3_density_ratio(p, 8)), over = ratio / double(case3_bound(p));
-      worst_over_bound = std::max(worst_over_bound, over);
-      lo_ratio = std::min(lo_ratio, ratio), hi_ratio = std::max(hi_ratio, ratio);
-      // Colour by log2 of the ratio over [0, 1] (ratio 1 to 2), the bound's range for d >= 1.094 r.
-      const Rgb c = sequential_color(std::clamp(std::log2(ratio), 0.0, 1.0));
+  for (long long i = 0; i < nx; ++i) {
+    const std::vector<double> ratio = numbers_of(ratios.get_array()[i], "ratio row"),
+                              bound = numbers_of(bounds.get_array()[i], "bound row");
+    if (ratio.size() != std::size_t(ny) || bound.size() != std::size_t(ny))
+      throw std::runtime_error("a ratio or bound row does not hold ny entries");
+    for (long long j = 0; j < ny; ++j) {
+      if (std::isnan(ratio[j])) continue;
+      worst_over_bound = std::max(worst_over_bound, ratio[j] / bound[j]);
+      lo_ratio = std::min(lo_ratio, ratio[j]), hi_ratio = std::max(hi_ratio, ratio[j]);
       dots << "<rect x=\"" << L + i * cw << "\" y=\"" << B - (j + 1) * ch << "\" width=\"" << cw + 0.3 << "\" height=\""
-           << ch + 0.3 << "\" fill=\"rgb(" << int(c[0]) << "," << int(c[1]) << "," << int(c[2]) << ")\"/>";
+           << ch + 0.3 << "\" fill=\"" << rgb(sequential_color(std::clamp(std::log2(ratio[j]), 0.0, 1.0))) << "\"/>";
     }
+  }
   std::ostringstream o;
-  o << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << W << "\" height=\"" << H << "\" role=\"img\"><title>"
-    << "Case-3 density ratio over geometry</title><text x=\"6\" y=\"15\" font-size=\"12\">Case-3 density ratio "
-    << "max/min of Alg. 4 (long double), " << nx << " x " << ny << " geometries</text><rect x=\"" << L << "\" y=\"" << T
-    << "\" width=\"" << R - L << "\" height=\"" << B - T << "\" fill=\"#fff\" stroke=\"#444\"/>" << dots.str();
-  for (int k = 0; k <= 3; ++k)
-    o << "<text x=\"" << L + (R - L) * (k - std::log10(1.001)) / (3 - std::log10(1.001)) << "\" y=\"" << B + 13
+  o << svg_frame_start("Case-3 density ratio over geometry", "Case-3 density ratio max/min of Alg. 4 (" +
+                                                                 html_escape(string_of(member(m, "scalar"), "scalar")) +
+                                                                 "), " + std::to_string(nx) + " x " +
+                                                                 std::to_string(ny) + " geometries")
+    << dots.str();
+  for (int k = int(std::floor(xr[0])); k <= int(std::floor(xr[1])); ++k)
+    o << "<text x=\"" << L + (R - L) * (k - xr[0]) / (xr[1] - xr[0]) << "\" y=\"" << B + 13
       << "\" font-size=\"10\" text-anchor=\"middle\">1e" << k << "</text>";
   for (int k = 0; k <= 4; ++k)
     o << "<text x=\"" << L - 4 << "\" y=\"" << B - (B - T) * k / 4 + 3 << "\" font-size=\"10\" text-anchor=\"end\">"
-      << k / 4.0 << "</text>";
-  o << "<text x=\"" << (L + R) / 2 << "\" y=\"" << H - 6
-    << "\" font-size=\"11\" text-anchor=\"middle\">distance / "
-       "radius</text><text x=\"12\" y=\""
-    << (T + B) / 2
-    << "\" font-size=\"11\" text-anchor=\"middle\" "
-       "transform=\"rotate(-90 12 "
-    << (T + B) / 2 << ")\">depth of the centre / r_y</text>";
-  for (int k = 0; k <= 8; ++k) {  // colour bar
-    const Rgb c = sequential_color(k / 8.0);
-    o << "<rect x=\"" << R + 12 << "\" y=\"" << B - (B - T) * (k + 1) / 9.0 << "\" width=\"14\" height=\""
-      << (B - T) / 9.0 + 0.5 << "\" fill=\"rgb(" << int(c[0]) << "," << int(c[1]) << "," << int(c[2]) << ")\"/>";
-  }
-  o << "<text x=\"" << R + 30 << "\" y=\"" << B << "\" font-size=\"10\">1</text><text x=\"" << R + 30 << "\" y=\""
-    << T + 8 << "\" font-size=\"10\">2+</text></svg><p class=\"muted\">Ratio from " << num(lo_ratio) << " to "
-    << num(hi_ratio) << "; largest ratio / paper's bound: " << num(worst_over_bound)
+      << yr[0] + (yr[1] - yr[0]) * k / 4.0 << "</text>";
+  o << svg_frame_end("distance / radius", "depth of the centre / r_y", "1", "2+") << "<p class=\"muted\">Ratio from "
+    << num(lo_ratio) << " to " << num(hi_ratio) << "; largest ratio / paper's bound: " << num(worst_over_bound)
     << " (must be &lt;= 1 up to rounding). The worst case over the continuous geometry is the search "
        "projected-cap-case3-ratio.</p>";
   return o.str();
 }
 
-std::string geometry_maps_section() {
+// data/<dir>/geometry-map.json drawn by `render`, or a note saying why it cannot be.
+std::string geometry_map(const fs::path& data, const std::string& dir, std::string (*render)(const json::object&)) {
+  const std::string name = "data/" + dir + "/geometry-map.json";
+  const fs::path p = data / dir / "geometry-map.json";
+  if (!fs::exists(p)) return not_run(name + " does not exist", "build/geometry_maps");
+  std::string err;
+  const auto v = load_json(p, err);
+  if (v && !v->is_object()) err = p.string() + " is not a JSON object";
+  if (err.empty()) try {
+      return "<p class=\"muted\">From <code>" + name + "</code>.</p>\n" + render(v->get_object());
+    } catch (const std::exception& e) {
+      err = p.string() + ": " + e.what();
+    }
+  return "<p class=\"notrun\">" + html_escape(err) + "</p>\n";
+}
+
+std::string geometry_maps_section(const fs::path& data) {
   return "<h2 id=\"geometry-maps\">Maps over geometry</h2>\n<h3>Polygon backward error (Peters 2021 Sec. 3.6)</h3>\n" +
-         polygon_backward_error_map(0, 2000) + polygon_backward_error_map(2, 2000) +
-         "<h3>Case-3 density ratio (Peters &amp; Dachsbacher 2019 Sec. 3.5)</h3>\n" + case3_ratio_map(60, 40) + "\n";
+         geometry_map(data, "polygon", polygon_backward_error_maps) +
+         "<h3>Case-3 density ratio (Peters &amp; Dachsbacher 2019 Sec. 3.5)</h3>\n" +
+         geometry_map(data, "projected-cap", case3_ratio_map) + "\n";
 }
 
 }  // namespace
@@ -853,12 +917,14 @@ ReportSummary write_report(const ReportOptions& opt) {
   x << "</table>\n";
   if (opt.data_dir.empty()) {
     x << "<h2 id=\"claims\">Data</h2>" << not_run("no data directory given", "warpcheck report --data data ...")
-      << "<span id=\"worst\"></span><span id=\"fuzz\"></span><span id=\"bench\"></span>";
+      << "<span id=\"worst\"></span><span id=\"fuzz\"></span><span id=\"bench\"></span><span "
+         "id=\"geometry-maps\"></span>";
   } else {
     const fs::path data(opt.data_dir);
-    x << claims_section(data) << worst_case_section(data) << fuzz_section(data) << bench_section(data);
+    x << claims_section(data) << worst_case_section(data) << fuzz_section(data) << bench_section(data)
+      << geometry_maps_section(data);
   }
-  x << geometry_maps_section() << page_end();
+  x << page_end();
   write_text(out / "index.html", x.str());
   sum.files.push_back("index.html");
   return sum;
