@@ -192,52 +192,83 @@ std::string marginal_bars_svg(const std::vector<double>& res, const std::string&
   return o.str();
 }
 
-// Writes the PNGs and the EXR of one chi2 result; returns the HTML figure block.
-std::string chi2_maps(const Result& r, std::optional<long long> samples, const fs::path& out, ReportSummary& sum) {
-  const int R = r.map_rows, A = r.map_cols;
-  const std::size_t n = std::size_t(R) * A;
-  std::vector<double> res(n);
-  double rmax = 0, vlo = 1e300, vhi = -1e300;
+// The signed residuals (o - e) / sqrt(e) of one chi2 grid, the range of its counts, and the samples off the grid.
+struct Residuals {
+  std::vector<double> bins;
+  double rmax = 0, vlo = 1e300, vhi = -1e300;  // largest finite |residual|; count range of the maps
   std::size_t worst = 0, zero_mass_hits = 0;
+  std::optional<double> ring;  // residual of the samples off the grid, when the run's sample count is known
+  double off_o = 0, off_e = 0;
+};
+
+Residuals residuals(const Result& r, std::optional<long long> samples) {
+  const std::size_t n = std::size_t(r.map_rows) * r.map_cols;
+  const double inf = std::numeric_limits<double>::infinity();
+  Residuals s;
+  s.bins.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     const double o = r.observed[i], e = r.expected[i];
-    vlo = std::min({vlo, o, e}), vhi = std::max({vhi, o, e});
+    s.vlo = std::min({s.vlo, o, e}), s.vhi = std::max({s.vhi, o, e});
     if (e > 0)
-      res[i] = (o - e) / std::sqrt(e);
+      s.bins[i] = (o - e) / std::sqrt(e);
     else
-      res[i] = o > 0 ? std::numeric_limits<double>::infinity() : 0, zero_mass_hits += o > 0;
-    if (std::abs(res[i]) > std::abs(res[worst])) worst = i;
-    if (std::isfinite(res[i])) rmax = std::max(rmax, std::abs(res[i]));
+      s.bins[i] = o > 0 ? inf : 0, s.zero_mass_hits += o > 0;
+    if (std::abs(s.bins[i]) > std::abs(s.bins[s.worst])) s.worst = i;
+    if (std::isfinite(s.bins[i])) s.rmax = std::max(s.rmax, std::abs(s.bins[i]));
   }
-  if (!(vhi - vlo > 1e-9 * std::abs(vhi))) vlo = 0;
+  if (!(s.vhi - s.vlo > 1e-9 * std::abs(s.vhi))) s.vlo = 0;
   // Samples off the grid (outside the bounding cap or declined): the run's sample count minus the grid's total,
-  // against the expected n (1 - mass on the grid). Shown as a ring around the residual map.
-  std::optional<double> ring;
-  double off_o = 0, off_e = 0;
+  // against the expected n (1 - mass on the grid).
   if (samples) {
     double so = 0, se = 0;
     for (std::size_t i = 0; i < n; ++i) so += r.observed[i], se += r.expected[i];
-    off_o = double(*samples) - so, off_e = std::max(0.0, double(*samples) - se);
+    s.off_o = double(*samples) - so, s.off_e = std::max(0.0, double(*samples) - se);
     // Expected mass off the grid below one sample is quadrature noise, not a prediction: treat it as zero.
-    if (off_e < 1) off_e = 0;
-    ring = off_e > 0 ? (off_o - off_e) / std::sqrt(off_e) : off_o > 0.5 ? std::numeric_limits<double>::infinity() : 0;
-    if (std::isfinite(*ring)) rmax = std::max(rmax, std::abs(*ring));
+    if (s.off_e < 1) s.off_e = 0;
+    s.ring = s.off_e > 0 ? (s.off_o - s.off_e) / std::sqrt(s.off_e) : s.off_o > 0.5 ? inf : 0;
+    if (std::isfinite(*s.ring)) s.rmax = std::max(s.rmax, std::abs(*s.ring));
   }
+  return s;
+}
+
+// Bar charts of the residuals of the grid's marginals, per radial row and per azimuth column.
+std::string marginal_figures(const Result& r) {
+  const int R = r.map_rows, A = r.map_cols;
+  std::vector<double> ro(R, 0), re(R, 0), ao(A, 0), ae(A, 0), rr(R), ar(A);
+  for (int i = 0; i < R; ++i)
+    for (int j = 0; j < A; ++j) {
+      const std::size_t k = std::size_t(i) * A + j;
+      ro[i] += r.observed[k], re[i] += r.expected[k], ao[j] += r.observed[k], ae[j] += r.expected[k];
+    }
+  auto z = [](double o, double e) {
+    return e > 0 ? (o - e) / std::sqrt(e) : o > 0 ? std::numeric_limits<double>::infinity() : 0.0;
+  };
+  for (int i = 0; i < R; ++i) rr[i] = z(ro[i], re[i]);
+  for (int j = 0; j < A; ++j) ar[j] = z(ao[j], ae[j]);
+  return "<figure>" + marginal_bars_svg(rr, "residual per radial row", "row (t from 0 at the centre to 1 at the rim)") +
+         "</figure><figure>" + marginal_bars_svg(ar, "residual per azimuth column", "column (phi from 0 to 2 pi)") +
+         "</figure>";
+}
+
+// Writes the PNGs and the EXR of one chi2 result; returns the HTML figure block.
+std::string chi2_maps(const Result& r, std::optional<long long> samples, const fs::path& out, ReportSummary& sum) {
+  const int R = r.map_rows, A = r.map_cols;
+  const Residuals s = residuals(r, samples);
   // Residual scale: at least +-4 so that noise (|r| ~ 1) stays pale and a failure saturates.
-  const double scale = std::max(4.0, rmax);
+  const double scale = std::max(4.0, s.rmax), vlo = s.vlo, vhi = s.vhi;
   const std::string base =
       "img/" + safe_name(r.kernel) + "__" + safe_name(r.scalar) + "__" + safe_name(r.config) + "__" + safe_name(r.test);
   auto seq = [&](double v) { return sequential_color((v - vlo) / (vhi - vlo > 0 ? vhi - vlo : 1)); };
   auto div = [&](double v) { return diverging_color(std::isfinite(v) ? v / scale : v > 0 ? 1 : -1); };
   write_png((out / (base + "-observed.png")).string(), polar_map(R, A, r.observed, 256, seq));
   write_png((out / (base + "-expected.png")).string(), polar_map(R, A, r.expected, 256, seq));
-  write_png((out / (base + "-residual.png")).string(), polar_map(R, A, res, 256, div, ring));
+  write_png((out / (base + "-residual.png")).string(), polar_map(R, A, s.bins, 256, div, s.ring));
   std::vector<float> fo(r.observed.begin(), r.observed.end()), fe(r.expected.begin(), r.expected.end()),
-      fr(res.begin(), res.end());
+      fr(s.bins.begin(), s.bins.end());
   write_exr((out / (base + ".exr")).string(), A, R, {{"observed", fo}, {"expected", fe}, {"residual", fr}});
-  for (const char* s : {"-observed.png", "-expected.png", "-residual.png", ".exr"}) sum.files.push_back(base + s);
+  for (const char* x : {"-observed.png", "-expected.png", "-residual.png", ".exr"}) sum.files.push_back(base + x);
 
-  const int wr = int(worst / A), wa = int(worst % A);
+  const int wr = int(s.worst / A), wa = int(s.worst % A);
   std::ostringstream o;
   o << "<div class=\"maps\" id=\"maps-" << result_anchor(r) << "\"><h4>chi2 maps: " << html_escape(r.scalar) << " / "
     << html_escape(r.config) << " <span class=\"" << (r.failed() ? "fail" : "") << "\">(" << verdict(r)
@@ -250,33 +281,18 @@ std::string chi2_maps(const Result& r, std::optional<long long> samples, const f
       << colorbar_svg(d, d ? -scale : vlo, d ? scale : vhi, "cb-" + safe_name(r.scalar + r.config) + which)
       << "</figcaption></figure>";
   }
-  {  // marginal residuals per radial row and per azimuth column
-    std::vector<double> ro(R, 0), re(R, 0), ao(A, 0), ae(A, 0), rr(R), ar(A);
-    for (int i = 0; i < R; ++i)
-      for (int j = 0; j < A; ++j) {
-        const std::size_t k = std::size_t(i) * A + j;
-        ro[i] += r.observed[k], re[i] += r.expected[k], ao[j] += r.observed[k], ae[j] += r.expected[k];
-      }
-    auto z = [](double o, double e) {
-      return e > 0 ? (o - e) / std::sqrt(e) : o > 0 ? std::numeric_limits<double>::infinity() : 0.0;
-    };
-    for (int i = 0; i < R; ++i) rr[i] = z(ro[i], re[i]);
-    for (int j = 0; j < A; ++j) ar[j] = z(ao[j], ae[j]);
-    o << "<figure>" << marginal_bars_svg(rr, "residual per radial row", "row (t from 0 at the centre to 1 at the rim)")
-      << "</figure><figure>" << marginal_bars_svg(ar, "residual per azimuth column", "column (phi from 0 to 2 pi)")
-      << "</figure>";
-  }
-  o << "<p class=\"muted\">Equal-area view of the bounding cap from above: radius sqrt(t), t = (1 - cos theta) / "
+  o << marginal_figures(r)
+    << "<p class=\"muted\">Equal-area view of the bounding cap from above: radius sqrt(t), t = (1 - cos theta) / "
        "(1 - cos theta_max) in "
     << R << " rows; azimuth phi counter-clockwise from the cap frame's x axis (right) in " << A
-    << " columns; every bin covers the same pixel area. Largest residual " << num(res[worst]) << " in t in ["
+    << " columns; every bin covers the same pixel area. Largest residual " << num(s.bins[s.worst]) << " in t in ["
     << num(double(wr) / R) << ", " << num(double(wr + 1) / R) << "), phi/2pi in [" << num(double(wa) / A) << ", "
     << num(double(wa + 1) / A) << ")"
-    << (zero_mass_hits ? "; " + std::to_string(zero_mass_hits) + " bins with samples but zero expected mass" : "")
-    << (ring ? ". The ring around the residual map: samples off the grid (outside the bounding cap or declined), " +
-                   num(off_o, 6) + " observed against " + num(off_e, 6) + " expected" +
-                   (off_o > 0.5 && off_e == 0 ? " (impossible under the pdf: saturated red)" : "")
-             : std::string(""))
+    << (s.zero_mass_hits ? "; " + std::to_string(s.zero_mass_hits) + " bins with samples but zero expected mass" : "")
+    << (s.ring ? ". The ring around the residual map: samples off the grid (outside the bounding cap or declined), " +
+                     num(s.off_o, 6) + " observed against " + num(s.off_e, 6) + " expected" +
+                     (s.off_o > 0.5 && s.off_e == 0 ? " (impossible under the pdf: saturated red)" : "")
+               : std::string(""))
     << ". Exact values (32-bit float; the JSON has the 9-digit expected counts): <a href=\"" << base << ".exr\">"
     << safe_name(r.test) << ".exr</a> (channels observed, expected, residual; " << A << " x " << R
     << ", row = radial bin).</p></div>\n";
@@ -761,12 +777,12 @@ std::string geometry_map(const fs::path& data, const std::string& dir, std::stri
   if (!fs::exists(p)) return not_run(name + " does not exist", "build/geometry_maps");
   std::string err;
   const auto v = load_json(p, err);
-  if (v && !v->is_object()) err = p.string() + " is not a JSON object";
-  if (err.empty()) try {
-      return "<p class=\"muted\">From <code>" + name + "</code>.</p>\n" + render(v->get_object());
-    } catch (const std::exception& e) {
-      err = p.string() + ": " + e.what();
-    }
+  if (!v || !v->is_object()) err = err.empty() ? p.string() + " is not a JSON object" : err;
+  try {
+    if (err.empty()) return "<p class=\"muted\">From <code>" + name + "</code>.</p>\n" + render(v->get_object());
+  } catch (const std::exception& e) {
+    err = p.string() + ": " + e.what();
+  }
   return "<p class=\"notrun\">" + html_escape(err) + "</p>\n";
 }
 
@@ -777,76 +793,80 @@ std::string geometry_maps_section(const fs::path& data) {
          geometry_map(data, "projected-cap", case3_ratio_map) + "\n";
 }
 
-}  // namespace
-
-ReportSummary write_report(const ReportOptions& opt) {
-  if (opt.out_dir.empty()) throw std::invalid_argument("write_report: no output directory");
-  const BatteryRun run = parse_battery_json(read_text(opt.results_path));
-  const fs::path out(opt.out_dir);
-  fs::create_directories(out / "img");
-  ReportSummary sum;
-  sum.results = run.results.size();
-
-  // Group by kernel (order of first appearance); columns: tests in order of first appearance.
+// The results grouped by kernel, kernels and tests in order of first appearance.
+struct Grouped {
   std::vector<std::string> kernels, tests;
   std::map<std::string, std::vector<const Result*>> by_kernel;
+};
+
+Grouped group(const BatteryRun& run, ReportSummary& sum) {
+  Grouped g;
   for (const Result& r : run.results) {
-    if (!by_kernel.count(r.kernel)) kernels.push_back(r.kernel);
-    by_kernel[r.kernel].push_back(&r);
-    if (std::find(tests.begin(), tests.end(), r.test) == tests.end()) tests.push_back(r.test);
+    if (!g.by_kernel.count(r.kernel)) g.kernels.push_back(r.kernel);
+    g.by_kernel[r.kernel].push_back(&r);
+    if (std::find(g.tests.begin(), g.tests.end(), r.test) == g.tests.end()) g.tests.push_back(r.test);
     sum.failures += r.failed();
     sum.known_limitation_failures += !r.passed && !r.known_limitation.empty();
   }
-  sum.kernels = kernels.size();
+  sum.kernels = g.kernels.size();
+  return g;
+}
 
-  const Registry reg = default_registry(), neg = negative_control_registry();
+// What the kernel pages draw sample sets from: the registry's and the negative controls' cases, and one
+// blue-noise point set.
+struct SampleSources {
+  Registry registry = default_registry(), controls = negative_control_registry();
   std::vector<const Case*> cases;
-  for (const auto& c : reg.cases()) cases.push_back(&c);
-  for (const auto& c : neg.cases()) cases.push_back(&c);
+  std::vector<std::array<double, 2>> blue;
+};
 
-  const auto blue = best_candidate_blue_noise(opt.blue_noise_points, 1);
-  // ---- kernel pages
-  for (const std::string& k : kernels) {
-    const auto& rs = by_kernel[k];
-    std::ostringstream p;
-    p << page_start("warpcheck: " + k) << "<p><a href=\"index.html\">&larr; all kernels</a></p><h1>" << html_escape(k)
-      << "</h1>\n";
-    std::size_t kf = 0;
-    for (const Result* r : rs) kf += r->failed();
-    p << "<div class=\"banner " << (kf ? "bad" : "good") << "\">"
-      << (kf ? std::to_string(kf) + " test(s) FAILED" : "all tests passed (or are documented known limitations)")
-      << "</div>\n<h2>Results</h2><table><tr><th>scalar</th><th>config</th><th>test</th><th>statistic</th>"
-         "<th>p-value</th><th>verdict</th><th>detail</th></tr>";
-    std::set<std::string> configs;
-    for (const Result* r : rs) {
-      configs.insert(r->config);
-      p << "<tr id=\"" << result_anchor(*r) << "\"><td>" << html_escape(r->scalar) << "</td><td>"
-        << html_escape(r->config) << "</td><td>" << html_escape(r->test) << "</td><td>"
-        << (r->statistic ? num(*r->statistic, 6) : "null") << "</td><td>" << (r->p_value ? num(*r->p_value, 4) : "-")
-        << "</td><td class=\"" << cell_class(*r) << "\">" << verdict(*r) << "</td><td>" << html_escape(r->detail)
-        << (r->known_limitation.empty() ? "" : "<br><i>known limitation: " + html_escape(r->known_limitation) + "</i>")
-        << (r->map_rows ? " <a href=\"#maps-" + result_anchor(*r) + "\">maps</a>" : "") << "</td></tr>";
-    }
-    p << "</table>\n<h2>chi2 maps</h2>\n";
-    bool any_map = false;
-    // Failing maps first: that is where a reader looks.
-    std::vector<const Result*> maps;
-    for (const Result* r : rs)
-      if (r->map_rows > 0) maps.push_back(r);
-    std::stable_sort(maps.begin(), maps.end(),
-                     [](const Result* a, const Result* b) { return a->failed() > b->failed(); });
-    for (const Result* r : maps) p << chi2_maps(*r, run.samples, out, sum), any_map = true;
-    if (!any_map)
-      p << "<p class=\"muted\">No chi2 maps in these results (results written before maps were recorded, or a "
-           "no-sample geometry).</p>";
-    p << "<h2>Sample sets</h2>\n" << sample_sets(k, cases, configs, opt, blue) << page_end();
-    write_text(out / kernel_page(k), p.str());
-    sum.files.push_back(kernel_page(k));
-  }
+std::string results_table(const std::vector<const Result*>& rs) {
+  std::ostringstream p;
+  p << "<h2>Results</h2><table><tr><th>scalar</th><th>config</th><th>test</th><th>statistic</th>"
+       "<th>p-value</th><th>verdict</th><th>detail</th></tr>";
+  for (const Result* r : rs)
+    p << "<tr id=\"" << result_anchor(*r) << "\"><td>" << html_escape(r->scalar) << "</td><td>"
+      << html_escape(r->config) << "</td><td>" << html_escape(r->test) << "</td><td>"
+      << (r->statistic ? num(*r->statistic, 6) : "null") << "</td><td>" << (r->p_value ? num(*r->p_value, 4) : "-")
+      << "</td><td class=\"" << cell_class(*r) << "\">" << verdict(*r) << "</td><td>" << html_escape(r->detail)
+      << (r->known_limitation.empty() ? "" : "<br><i>known limitation: " + html_escape(r->known_limitation) + "</i>")
+      << (r->map_rows ? " <a href=\"#maps-" + result_anchor(*r) + "\">maps</a>" : "") << "</td></tr>";
+  p << "</table>\n";
+  return p.str();
+}
 
-  // ---- index
+void write_kernel_page(const std::string& k, const std::vector<const Result*>& rs, const BatteryRun& run,
+                       const ReportOptions& opt, const SampleSources& src, ReportSummary& sum) {
+  const fs::path out(opt.out_dir);
+  std::ostringstream p;
+  p << page_start("warpcheck: " + k) << "<p><a href=\"index.html\">&larr; all kernels</a></p><h1>" << html_escape(k)
+    << "</h1>\n";
+  std::size_t kf = 0;
+  for (const Result* r : rs) kf += r->failed();
+  p << "<div class=\"banner " << (kf ? "bad" : "good") << "\">"
+    << (kf ? std::to_string(kf) + " test(s) FAILED" : "all tests passed (or are documented known limitations)")
+    << "</div>\n"
+    << results_table(rs) << "<h2>chi2 maps</h2>\n";
+  // Failing maps first: that is where a reader looks.
+  std::vector<const Result*> maps;
+  for (const Result* r : rs)
+    if (r->map_rows > 0) maps.push_back(r);
+  std::stable_sort(maps.begin(), maps.end(),
+                   [](const Result* a, const Result* b) { return a->failed() > b->failed(); });
+  for (const Result* r : maps) p << chi2_maps(*r, run.samples, out, sum);
+  if (maps.empty())
+    p << "<p class=\"muted\">No chi2 maps in these results (results written before maps were recorded, or a "
+         "no-sample geometry).</p>";
+  std::set<std::string> configs;
+  for (const Result* r : rs) configs.insert(r->config);
+  p << "<h2>Sample sets</h2>\n" << sample_sets(k, src.cases, configs, opt, src.blue) << page_end();
+  write_text(out / kernel_page(k), p.str());
+  sum.files.push_back(kernel_page(k));
+}
+
+// The index's head: the run's parameters, a banner when it is incomplete, and the failing tests first.
+std::string run_summary(const BatteryRun& run, const ReportOptions& opt, const ReportSummary& sum) {
   std::ostringstream x;
-  x << page_start("warpcheck report") << "<h1>warpcheck validation report</h1>\n";
   x << "<p>Results: <code>" << html_escape(opt.results_path) << "</code>; significance alpha = " << num(run.alpha)
     << " family-wise, " << html_escape(run.correction) << " correction across " << run.statistical_tests
     << " statistical tests" << (run.samples ? "; " + std::to_string(*run.samples) + " samples per case" : "")
@@ -858,48 +878,49 @@ ReportSummary write_report(const ReportOptions& opt) {
   for (const Result& r : run.results)
     if (r.failed()) failing.push_back(&r);
   if (failing.empty())
-    x << "<div class=\"banner good\">All " << run.results.size() << " tests passed"
-      << (sum.known_limitation_failures
-              ? " (" + std::to_string(sum.known_limitation_failures) + " failures are documented known limitations)"
-              : "")
-      << ".</div>\n";
-  else {
-    x << "<div class=\"banner bad\" id=\"failing\">" << failing.size() << " of " << run.results.size()
-      << " tests FAILED</div>\n<ul class=\"failing\">";
-    for (const Result* r : failing)
-      x << "<li><a href=\"" << kernel_page(r->kernel) << "#" << result_anchor(*r) << "\">" << html_escape(r->kernel)
-        << " / " << html_escape(r->scalar) << " / " << html_escape(r->config) << ": " << html_escape(r->test) << "</a> "
-        << (r->p_value ? "p = " + num(*r->p_value)
-                       : "statistic " + (r->statistic ? num(*r->statistic) : std::string("null")))
-        << " <span class=\"muted\">" << html_escape(r->detail) << "</span>"
-        << (r->map_rows
-                ? " <a href=\"" + kernel_page(r->kernel) + "#maps-" + result_anchor(*r) + "\">(residual map)</a>"
-                : "")
-        << "</li>";
-    x << "</ul>\n";
-  }
-  x << "<p><a href=\"#matrix\">matrix</a> | <a href=\"#claims\">paper vs ours</a> | <a href=\"#worst\">worst cases</a>"
-       " | <a href=\"#fuzz\">fuzz</a> | <a href=\"#bench\">benchmarks</a> | <a href=\"#geometry-maps\">maps over "
-       "geometry</a></p>\n";
+    return x.str() + "<div class=\"banner good\">All " + std::to_string(run.results.size()) + " tests passed" +
+           (sum.known_limitation_failures
+                ? " (" + std::to_string(sum.known_limitation_failures) + " failures are documented known limitations)"
+                : "") +
+           ".</div>\n";
+  x << "<div class=\"banner bad\" id=\"failing\">" << failing.size() << " of " << run.results.size()
+    << " tests FAILED</div>\n<ul class=\"failing\">";
+  for (const Result* r : failing)
+    x << "<li><a href=\"" << kernel_page(r->kernel) << "#" << result_anchor(*r) << "\">" << html_escape(r->kernel)
+      << " / " << html_escape(r->scalar) << " / " << html_escape(r->config) << ": " << html_escape(r->test) << "</a> "
+      << (r->p_value ? "p = " + num(*r->p_value)
+                     : "statistic " + (r->statistic ? num(*r->statistic) : std::string("null")))
+      << " <span class=\"muted\">" << html_escape(r->detail) << "</span>"
+      << (r->map_rows ? " <a href=\"" + kernel_page(r->kernel) + "#maps-" + result_anchor(*r) + "\">(residual map)</a>"
+                      : "")
+      << "</li>";
+  x << "</ul>\n";
+  return x.str();
+}
+
+// The pass/fail matrix: one row per kernel x scalar x configuration, one column per test.
+std::string matrix(const Grouped& g) {
+  std::ostringstream x;
   x << "<h2 id=\"matrix\">Pass/fail matrix</h2>\n<p class=\"muted\">Cells: p-value for statistical tests (judged "
        "together at alpha with the correction above), the statistic (relative error) for deterministic ones. "
        "Legend: <span style=\"background:#d8f0d8\">pass</span>, <span style=\"background:#e0302a;color:#fff\">"
        "FAIL</span>, <span style=\"background:#ffd27a\">fail, documented known limitation (striped)</span>, "
        "<span style=\"border:2px dashed #c88a00\">pass on a known-limitation case</span>. Hover a cell for its "
        "detail; click a kernel for its page.</p>\n<table><tr><th>kernel</th><th>scalar</th><th>config</th>";
-  for (const auto& t : tests) x << "<th>" << html_escape(t) << "</th>";
+  for (const auto& t : g.tests) x << "<th>" << html_escape(t) << "</th>";
   x << "</tr>\n";
-  for (const std::string& k : kernels) {
+  for (const std::string& k : g.kernels) {
+    const std::vector<const Result*>& rs = g.by_kernel.at(k);
     std::vector<std::pair<std::string, std::string>> rows;  // (scalar, config), order of appearance
-    for (const Result* r : by_kernel[k])
+    for (const Result* r : rs)
       if (std::find(rows.begin(), rows.end(), std::make_pair(r->scalar, r->config)) == rows.end())
         rows.emplace_back(r->scalar, r->config);
     for (const auto& [sc, cf] : rows) {
       x << "<tr><td><a href=\"" << kernel_page(k) << "\">" << html_escape(k) << "</a></td><td>" << html_escape(sc)
         << "</td><td>" << html_escape(cf) << "</td>";
-      for (const auto& t : tests) {
+      for (const auto& t : g.tests) {
         const Result* hit = nullptr;
-        for (const Result* r : by_kernel[k])
+        for (const Result* r : rs)
           if (r->scalar == sc && r->config == cf && r->test == t) hit = r;
         if (!hit) {
           x << "<td class=\"absent\">&middot;</td>";
@@ -915,6 +936,16 @@ ReportSummary write_report(const ReportOptions& opt) {
     }
   }
   x << "</table>\n";
+  return x.str();
+}
+
+void write_index(const BatteryRun& run, const ReportOptions& opt, const Grouped& g, ReportSummary& sum) {
+  std::ostringstream x;
+  x << page_start("warpcheck report") << "<h1>warpcheck validation report</h1>\n" << run_summary(run, opt, sum);
+  x << "<p><a href=\"#matrix\">matrix</a> | <a href=\"#claims\">paper vs ours</a> | <a href=\"#worst\">worst cases</a>"
+       " | <a href=\"#fuzz\">fuzz</a> | <a href=\"#bench\">benchmarks</a> | <a href=\"#geometry-maps\">maps over "
+       "geometry</a></p>\n"
+    << matrix(g);
   if (opt.data_dir.empty()) {
     x << "<h2 id=\"claims\">Data</h2>" << not_run("no data directory given", "warpcheck report --data data ...")
       << "<span id=\"worst\"></span><span id=\"fuzz\"></span><span id=\"bench\"></span><span "
@@ -925,8 +956,25 @@ ReportSummary write_report(const ReportOptions& opt) {
       << geometry_maps_section(data);
   }
   x << page_end();
-  write_text(out / "index.html", x.str());
+  write_text(fs::path(opt.out_dir) / "index.html", x.str());
   sum.files.push_back("index.html");
+}
+
+}  // namespace
+
+ReportSummary write_report(const ReportOptions& opt) {
+  if (opt.out_dir.empty()) throw std::invalid_argument("write_report: no output directory");
+  const BatteryRun run = parse_battery_json(read_text(opt.results_path));
+  fs::create_directories(fs::path(opt.out_dir) / "img");
+  ReportSummary sum;
+  sum.results = run.results.size();
+  const Grouped g = group(run, sum);
+  SampleSources src;
+  for (const auto& c : src.registry.cases()) src.cases.push_back(&c);
+  for (const auto& c : src.controls.cases()) src.cases.push_back(&c);
+  src.blue = best_candidate_blue_noise(opt.blue_noise_points, 1);
+  for (const std::string& k : g.kernels) write_kernel_page(k, g.by_kernel.at(k), run, opt, src, sum);
+  write_index(run, opt, g, sum);
   return sum;
 }
 
