@@ -1,6 +1,5 @@
 // The report's images: colour maps, the equal-area polar view of a chi2 grid, PNG (libpng) and OpenEXR
-// (32-bit FLOAT channels through Imf::OutputFile; Imf::RgbaOutputFile would round to half, see
-// shared/notes/toolchain.md) writing.
+// (32-bit FLOAT channels through Imf::OutputFile; Imf::RgbaOutputFile would round to half) writing.
 #include <png.h>
 
 #include <ImfChannelList.h>

@@ -432,9 +432,9 @@ std::string claims_section(const fs::path& data) {
   };
   const Family fams[] = {
       {"projected-cap", "Projected spherical caps (Peters &amp; Dachsbacher 2019): quintic error, Case-3 bounds",
-       "build/projected_cap_claims (validation/tools/, issue 3)"},
+       "build/projected_cap_claims"},
       {"polygon", "Polygons (Peters 2021): backward-error percentiles", "build/polygon_claims --cases 1000000"},
-      {"sptd", "SPTD / LTC: timings and errors", "build/sptd_claims (validation/tools/, issue 5)"},
+      {"sptd", "SPTD / LTC: timings and errors", "build/sptd_claims"},
   };
   std::set<std::string> shown;
   auto one = [&](const std::string& dir, const std::string& title, const std::string& command) {

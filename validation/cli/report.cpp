@@ -1,4 +1,4 @@
-// warpcheck report: the HTML report of a battery run (validation/include/warpcheck/validation/report.h).
+// warpcheck report: the HTML report of a battery run (the generator is reports/, declared in reports/report.h).
 #include <cstdio>
 
 #include "commands.h"
@@ -13,13 +13,17 @@ const char* kReportHelp =
     "\n"
     "Writes a static, offline HTML site into DIR: index.html (pass/fail matrix of kernels x configurations x\n"
     "tests with p-values, alpha and correction; failing tests listed first; the papers' figures beside ours,\n"
-    "worst-case searches, fuzz campaigns, benchmarks) and one page per kernel (its results, observed / expected /\n"
-    "residual maps of each chi2 test as PNG with 32-bit OpenEXR beside them, and sample sets).\n"
+    "worst-case searches, fuzz campaigns, benchmarks, maps over geometry) and one page per kernel (its results,\n"
+    "observed / expected / residual maps of each chi2 test as PNG with 32-bit OpenEXR beside them, and sample\n"
+    "sets). It draws what the data directory holds and computes none of it.\n"
     "\n"
     "  --out DIR       output directory (created if missing)\n"
-    "  --from RESULTS  battery results JSON from 'warpcheck validate --json' (default results/results.json)\n"
-    "  --data DIR      data directory with claims, worst cases, fuzz and bench JSON (default: the source tree's\n"
-    "                  data/); missing inputs give a section that says how to produce them\n"
+    "  --from RESULTS  battery results JSON from 'warpcheck validate --json' (default: the source tree's\n"
+    "                  reports/results.json, which scripts/battery.sh writes)\n"
+    "  --data DIR      data directory with claims, worst cases, fuzz, bench and geometry-map JSON (default: the\n"
+    "                  source tree's data/); missing inputs give a section that says how to produce them\n"
+    "\n"
+    "scripts/battery.sh writes its report to reports/html/ (open reports/html/index.html).\n"
     "\n"
     "Exit status: 0 when the report was written, 1 when it could not be (unreadable results), 2 on bad\n"
     "arguments. The exit status does not reflect the tests' verdicts: read the report.\n";
@@ -28,7 +32,7 @@ const char* kReportHelp =
 
 int report_main(const std::vector<std::string>& a) {
   validation::report::ReportOptions opt;
-  opt.results_path = "results/results.json";
+  opt.results_path = std::string(WARPCHECK_SOURCE_DIR) + "/reports/results.json";
   opt.data_dir = std::string(WARPCHECK_SOURCE_DIR) + "/data";
   for (std::size_t i = 0; i < a.size(); ++i) {
     const std::string& f = a[i];

@@ -156,10 +156,15 @@ const Fixture& fixture() {
       }
     apply_correction(all, 0.01, Correction::kHolm);
     std::ofstream(x.results) << to_json(all, 0.01, Correction::kHolm, "\"samples\":20000,\"seed\":1,\"complete\":true");
-    // A data directory with a fuzz summary and a worst case with a history; no claims, no benchmarks (those
-    // sections must say "not run").
+    // A data directory with a fuzz summary, a worst case with a history and the committed geometry maps; no
+    // claims, no benchmarks (those sections must say "not run").
     fs::create_directories(x.data / "fuzz");
     fs::create_directories(x.data / "worst-cases");
+    for (const char* family : {"polygon", "projected-cap"}) {
+      fs::create_directories(x.data / family);
+      fs::copy_file(fs::path(WARPCHECK_SOURCE_DIR) / "data" / family / "geometry-map.json",
+                    x.data / family / "geometry-map.json");
+    }
     std::ofstream(x.data / "fuzz" / "summary.json")
         << R"({"description":"test","targets":{"fuzz_sphere_double":{"command":"fuzz/campaign.sh","executions":10,)"
            R"("exec_per_s":5,"cov":3,"ft":4,"findings":[{"signature":"x <double>: example"}]}}})";
@@ -276,6 +281,75 @@ TEST(Report, FailingNegativeControlIsRedInTheMatrixAndListedFirst) {
   EXPECT_NE(index.find("history of example"), std::string::npos);
 }
 
+// A report from a one-result run and the given data directory; returns its index.html.
+std::string index_with_data(const fs::path& dir, const fs::path& data) {
+  std::ofstream(dir / "r.json")
+      << R"({"alpha":0.01,"correction":"holm","statistical_tests":0,"results":[{"kernel":"k","scalar":"double",)"
+         R"("config":"c","test":"pdf-integral","statistic":1e-9,"p_value":null,"passed":true,"detail":"d"}]})";
+  ReportOptions ro;
+  ro.out_dir = (dir / "site").string();
+  ro.results_path = (dir / "r.json").string();
+  ro.data_dir = data.string();
+  write_report(ro);
+  return slurp(dir / "site" / "index.html");
+}
+
+TEST(Report, CommittedGeometryMapsAreDrawnFromTheDataDirectory) {
+  const fs::path dir = work_dir();
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string index = index_with_data(dir, fs::path(WARPCHECK_SOURCE_DIR) / "data");
+  EXPECT_NE(index.find("From <code>data/polygon/geometry-map.json</code>"), std::string::npos);
+  EXPECT_NE(index.find("<title>polygon backward error, 0 iterations</title>"), std::string::npos);
+  EXPECT_NE(index.find("<title>polygon backward error, 2 iterations</title>"), std::string::npos);
+  EXPECT_NE(index.find("From <code>data/projected-cap/geometry-map.json</code>"), std::string::npos);
+  EXPECT_NE(index.find("<title>Case-3 density ratio over geometry</title>"), std::string::npos);
+  EXPECT_EQ(index.find("geometry-map.json does not exist"), std::string::npos);
+  // The maps the tool writes by default: 2000 sectors from seed 1, a 60 x 40 grid of Case-3 geometries.
+  EXPECT_NE(index.find("2000 random decentral sectors (seed 1)"), std::string::npos);
+  EXPECT_NE(index.find("(long double), 60 x 40 geometries"), std::string::npos);
+}
+
+TEST(Report, GeometryMapsDrawTheNumbersInTheirFilesAndNothingElse) {
+  const fs::path dir = work_dir();
+  fs::remove_all(dir);
+  fs::create_directories(dir / "data" / "polygon");
+  fs::create_directories(dir / "data" / "projected-cap");
+  std::ofstream(dir / "data" / "polygon" / "geometry-map.json")
+      << R"({"scalar":"double","seed":7,"cases":2,"opening_angle_degrees":[90,45],"xi":[0.5,0.25],)"
+         R"("backward_error":[{"iterations":3,"values":[0.001,0]}]})";
+  std::ofstream(dir / "data" / "projected-cap" / "geometry-map.json")
+      << R"({"scalar":"long double","nx":1,"ny":2,"log10_distance_range":[0,3],"depth_range":[0,1],)"
+         R"("ratio":[[1.5,null]],"bound":[[2,null]]})";
+  const std::string index = index_with_data(dir, dir / "data");
+  // The polygon map: one dot per case, placed by angle / 180 and xi in the 400 x 240 plot area at (50, 24).
+  EXPECT_NE(index.find("after 3 iteration(s), double, 2 random decentral sectors (seed 7)"), std::string::npos);
+  EXPECT_NE(index.find("<circle cx=\"250\" cy=\"144\""), std::string::npos);
+  EXPECT_NE(index.find("<circle cx=\"150\" cy=\"204\""), std::string::npos);
+  EXPECT_NE(index.find("Largest of these 2: 0.001."), std::string::npos);
+  // The Case-3 map: the one Case-3 cell, ratio 1.5 against the bound 2; the null cell is not drawn.
+  EXPECT_NE(index.find("(long double), 1 x 2 geometries"), std::string::npos);
+  EXPECT_NE(index.find("Ratio from 1.5 to 1.5; largest ratio / paper's bound: 0.75 "), std::string::npos);
+  EXPECT_NE(index.find("<rect x=\"50\" y=\"144\" width=\"400.3\" height=\"120.3\""), std::string::npos);
+  EXPECT_EQ(index.find("<rect x=\"50\" y=\"24\" width=\"400.3\""), std::string::npos);
+}
+
+TEST(Report, MissingOrMalformedGeometryMapIsReportedNotComputed) {
+  const fs::path dir = work_dir();
+  fs::remove_all(dir);
+  fs::create_directories(dir / "data" / "projected-cap");
+  std::ofstream(dir / "data" / "projected-cap" / "geometry-map.json")
+      << R"({"scalar":"long double","nx":2,"ny":1,"log10_distance_range":[0,3],"depth_range":[0,1],)"
+         R"("ratio":[[1.5]],"bound":[[2]]})";
+  const std::string index = index_with_data(dir, dir / "data");
+  EXPECT_NE(index.find("Not run: data/polygon/geometry-map.json does not exist. Produce it with <code>"
+                       "build/geometry_maps</code>"),
+            std::string::npos);
+  EXPECT_NE(index.find("geometry-map.json: nx, ny, the ranges and the ratio / bound rows do not agree"),
+            std::string::npos);
+  EXPECT_EQ(index.find("<svg"), std::string::npos);
+}
+
 TEST(Report, ResidualMapExrHoldsTheSignedResidualOfEveryBin) {
   const Fixture& f = fixture();
   const BatteryRun run = parse_battery_json(slurp(f.results));
@@ -293,7 +367,9 @@ TEST(Report, ResidualMapExrHoldsTheSignedResidualOfEveryBin) {
     for (std::size_t i = 0; i < obs.size(); ++i) {
       EXPECT_EQ(double(obs[i]), r.observed[i]);  // counts below 2^24 are exact in float
       const double e = r.expected[i];
-      if (e > 0) EXPECT_EQ(res[i], float((r.observed[i] - e) / std::sqrt(e)));
+      if (e > 0) {
+        EXPECT_EQ(res[i], float((r.observed[i] - e) / std::sqrt(e)));
+      }
     }
     ++checked;
   }
@@ -371,4 +447,5 @@ TEST(Report, KnownLimitationFailuresAreMarkedDistinctlyAndDoNotFailTheRun) {
   EXPECT_NE(index.find("INCOMPLETE"), std::string::npos);
   EXPECT_NE(index.find("sidak correction"), std::string::npos);
   EXPECT_NE(index.find("Not run: no data directory given"), std::string::npos);
+  EXPECT_NE(index.find("id=\"geometry-maps\""), std::string::npos);  // the table of contents' target
 }
