@@ -115,58 +115,68 @@ template <class T> bool edge_in_plane(const Vec3<T>& e, T err, const Vec3<T>& nh
   return scaled.norm() > scaled_err;
 }
 
-// kNone for a valid light; otherwise kNonFinite, kZeroSize or kInvalidGeometry, with a message if asked. Each vertex
-// is known to vertex_rounding |V_k|_inf (ltc.h passes its own bound for M^-1 P).
-template <class T> NoSample check_polygon(const PolygonLight<T>& p, std::string* message = nullptr,
-                                          T vertex_rounding = kPolygonVertexRounding<T>) {
-  auto fail = [&](NoSample r, const char* why) {
-    if (message) *message = why;
-    return r;
-  };
-  if (p.count < 3) return fail(NoSample::kInvalidGeometry, "a polygon needs at least 3 vertices");
-  if (p.count > kMaxPolygonVertices) return fail(NoSample::kInvalidGeometry, "more than 8 vertices");
+namespace polygon_check_detail {
+
+// A check's verdict: kNone, or the reason and why.
+struct Verdict {
+  NoSample reason = NoSample::kNone;
+  const char* why = "";
+  bool ok() const { return reason == NoSample::kNone; }
+};
+
+// 3 to 8 finite vertices, no two consecutive ones equal, none visited twice (no convex polygon does that, and the
+// turning test can pass a zero-area loop).
+template <class T> Verdict check_vertices(const PolygonLight<T>& p) {
+  if (p.count < 3) return {NoSample::kInvalidGeometry, "a polygon needs at least 3 vertices"};
+  if (p.count > kMaxPolygonVertices) return {NoSample::kInvalidGeometry, "more than 8 vertices"};
   for (int i = 0; i < p.count; ++i)
-    if (!all_finite(p.vertices[i])) return fail(NoSample::kNonFinite, "non-finite vertex");
+    if (!all_finite(p.vertices[i])) return {NoSample::kNonFinite, "non-finite vertex"};
+  for (int i = 0; i < p.count; ++i)
+    if (p.vertices[i] == p.vertices[(i + 1) % p.count])
+      return {NoSample::kInvalidGeometry, "two consecutive vertices coincide"};
+  for (int i = 0; i < p.count; ++i)
+    for (int j = i + 2; j < p.count; ++j)
+      if (p.vertices[i] == p.vertices[j] && !(i == 0 && j == p.count - 1))
+        return {NoSample::kInvalidGeometry, "a vertex repeats"};
+  return {};
+}
+
+// A nonzero area, wider than the planarity tolerance (else no determined plane), every vertex within that tolerance
+// of the plane. Sets nhat, the unit area vector.
+template <class T> Verdict check_plane(const PolygonLight<T>& p, Vec3<T>& nhat) {
   T diameter = 0, magnitude = 0;
   for (int i = 0; i < p.count; ++i) {
     magnitude = std::max(magnitude, p.vertices[i].cwiseAbs().maxCoeff());
     for (int j = i + 1; j < p.count; ++j) diameter = std::max(diameter, (p.vertices[i] - p.vertices[j]).norm());
   }
-  for (int i = 0; i < p.count; ++i)
-    if (p.vertices[i] == p.vertices[(i + 1) % p.count])
-      return fail(NoSample::kInvalidGeometry, "two consecutive vertices coincide");
-  // A vertex visited twice: no convex polygon does that, and the turning test can pass a zero-area loop.
-  for (int i = 0; i < p.count; ++i)
-    for (int j = i + 2; j < p.count; ++j)
-      if (p.vertices[i] == p.vertices[j] && !(i == 0 && j == p.count - 1))
-        return fail(NoSample::kInvalidGeometry, "a vertex repeats");
   const Vec3<T> area2 = polygon_area_vector(p);
   const T area2_norm = area2.norm();
-  if (!(area2_norm > T(0)) || !std::isfinite(area2_norm)) return fail(NoSample::kZeroSize, "zero area");
-  const Vec3<T> nhat = area2 / area2_norm;
-  const T eps = std::numeric_limits<T>::epsilon();
+  if (!(area2_norm > T(0)) || !std::isfinite(area2_norm)) return {NoSample::kZeroSize, "zero area"};
+  nhat = area2 / area2_norm;
   const T width = area2_norm / diameter;
   const T tol = polygon_planarity_tolerance(width, magnitude);
-  // Narrower than its planarity tolerance: no determined plane.
-  if (!(width > tol))
-    return fail(NoSample::kZeroSize, "narrower than its planarity tolerance (zero area up to rounding)");
+  if (!(width > tol)) return {NoSample::kZeroSize, "narrower than its planarity tolerance (zero area up to rounding)"};
   for (int i = 0; i < p.count; ++i)
     if (std::abs(nhat.dot(p.vertices[i] - p.vertices[0])) > tol)
-      return fail(NoSample::kInvalidGeometry, "vertices are not coplanar");
-  // Convexity: all turns agree with the area vector and add up to one revolution, taken between the edges longer than
-  // their rounding (edge_in_plane). A reflex turn is forgiven only within the vertices' rounding: s = nhat . (a x b)
-  // is off by at most |a| err_b + |b| err_a + err_a err_b.
+      return {NoSample::kInvalidGeometry, "vertices are not coplanar"};
+  return {};
+}
+
+// A spike (b back along a: a turn of +-pi by the sign of a rounding error in s = nhat . (a x b)) is never convex.
+template <class T> bool is_spike(const Vec3<T>& a, const Vec3<T>& b, T s) {
+  return a.dot(b) < T(0) && std::abs(s) <= T(8) * std::numeric_limits<T>::epsilon() * a.norm() * b.norm();
+}
+
+// Convexity: no spike at any vertex; the turns between the edges longer than their rounding (edge_in_plane) agree
+// with nhat and add up to one revolution. A reflex turn is forgiven only within the vertices' rounding: s is off by
+// at most |a| err_b + |b| err_a + err_a err_b.
+template <class T> Verdict check_convexity(const PolygonLight<T>& p, const Vec3<T>& nhat, T vertex_rounding) {
   auto rounding = [&](int k) { return vertex_rounding * p.vertices[(k + p.count) % p.count].cwiseAbs().maxCoeff(); };
-  // A spike (b back along a: a turn of +-pi by the sign of a rounding error) is never convex: |s| <= 8 eps |a| |b|
-  // with a . b < 0 is rejected at every vertex and between the kept edges.
-  auto is_spike = [&](const Vec3<T>& a, const Vec3<T>& b, T s) {
-    return a.dot(b) < T(0) && std::abs(s) <= T(8) * eps * a.norm() * b.norm();
-  };
   for (int i = 0; i < p.count; ++i) {
     const Vec3<T> a = p.vertices[i] - p.vertices[(i + p.count - 1) % p.count];
     const Vec3<T> b = p.vertices[(i + 1) % p.count] - p.vertices[i];
     if (is_spike(a, b, nhat.dot(kahan_cross<T>(a, b))))
-      return fail(NoSample::kInvalidGeometry, "polygon is not convex (a spike)");
+      return {NoSample::kInvalidGeometry, "polygon is not convex (a spike)"};
   }
   struct KeptEdge {
     Vec3<T> e;  // V_j+1 - V_j in the plane, scaled by a power of two (edge_in_plane)
@@ -179,19 +189,33 @@ template <class T> NoSample check_polygon(const PolygonLight<T>& p, std::string*
     KeptEdge k;
     if (edge_in_plane<T>(e, rounding(i) + rounding(i + 1), nhat, k.e, k.err)) kept[nk++] = k;
   }
-  if (nk < 3) return fail(NoSample::kZeroSize, "fewer than three edges longer than their rounding");
+  if (nk < 3) return {NoSample::kZeroSize, "fewer than three edges longer than their rounding"};
   T turning = 0;
   for (int i = 0; i < nk; ++i) {
     const KeptEdge &ka = kept[(i + nk - 1) % nk], &kb = kept[i];
     const T s = nhat.dot(kahan_cross<T>(ka.e, kb.e)), c = ka.e.dot(kb.e);
     const T s_err = ka.e.norm() * kb.err + kb.e.norm() * ka.err + ka.err * kb.err;
-    if (s < -s_err) return fail(NoSample::kInvalidGeometry, "polygon is not convex");
-    if (is_spike(ka.e, kb.e, s)) return fail(NoSample::kInvalidGeometry, "polygon is not convex (a spike)");
+    if (s < -s_err) return {NoSample::kInvalidGeometry, "polygon is not convex"};
+    if (is_spike(ka.e, kb.e, s)) return {NoSample::kInvalidGeometry, "polygon is not convex (a spike)"};
     turning += std::atan2(s, c);
   }
-  if (std::abs(turning - kTwoPi<T>) > T(0.5)) return fail(NoSample::kInvalidGeometry, "polygon is not simple");
-  if (message) message->clear();
-  return NoSample::kNone;
+  if (std::abs(turning - kTwoPi<T>) > T(0.5)) return {NoSample::kInvalidGeometry, "polygon is not simple"};
+  return {};
+}
+
+}  // namespace polygon_check_detail
+
+// kNone for a valid light; otherwise kNonFinite, kZeroSize or kInvalidGeometry, with a message if asked. Each vertex
+// is known to vertex_rounding |V_k|_inf (ltc.h passes its own bound for M^-1 P).
+template <class T> NoSample check_polygon(const PolygonLight<T>& p, std::string* message = nullptr,
+                                          T vertex_rounding = kPolygonVertexRounding<T>) {
+  using namespace polygon_check_detail;
+  Vec3<T> nhat = Vec3<T>::Zero();
+  Verdict v = check_vertices(p);
+  if (v.ok()) v = check_plane(p, nhat);
+  if (v.ok()) v = check_convexity(p, nhat, vertex_rounding);
+  if (message) *message = v.why;
+  return v.reason;
 }
 
 // ---- Clipping to the upper hemisphere (Peters 2021 Sec. 3.1) ----

@@ -293,6 +293,8 @@ template <class T> struct PolygonProjectedView {
   }
 };
 
+namespace polygon_projected_detail {
+
 // Whether the clipped polygon winds around the zenith (azimuth increments sum to 2 pi): robust where the signs of
 // the n_z are noise.
 template <class T> bool winds_around_zenith(const LocalPolygon<T>& p) {
@@ -304,38 +306,136 @@ template <class T> bool winds_around_zenith(const LocalPolygon<T>& p) {
   return sum > kPi<T>;
 }
 
-// vertex_rounding: as for check_polygon (polygon.h).
+// Whether the light is resolved by its local coordinates: not below 64 eps of the coordinates' scale, in extent or
+// in its image's width D |plane_distance| / d (d bounded below by |plane_distance| and the nearest vertex less D).
+template <class T> bool resolved_by_coordinates(const PolygonLightGeometry<T>& g, const PolygonView<T>& pv) {
+  T extent = 0, scale = 0;
+  for (int i = 0; i < g.light.count; ++i) {
+    extent = std::max(extent, Vec3<T>(g.light.vertices[i] - g.light.vertices[0]).cwiseAbs().maxCoeff());
+    scale = std::max(scale, g.light.vertices[i].cwiseAbs().maxCoeff());
+  }
+  scale += g.shading.position.cwiseAbs().maxCoeff();
+  if (!(extent > T(64) * std::numeric_limits<T>::epsilon() * scale)) return false;
+  T diameter = 0, nearest = std::numeric_limits<T>::infinity();
+  for (int i = 0; i < g.light.count; ++i) {
+    diameter = std::max(diameter, T(2) * Vec3<T>(g.light.vertices[i] - g.light.vertices[0]).stableNorm());
+    nearest = std::min(nearest, Vec3<T>(g.light.vertices[i] - g.shading.position).stableNorm());
+  }
+  const T h = std::abs(pv.plane_distance), d = std::max(h, nearest - diameter);
+  return diameter * (h / d) > T(64) * std::numeric_limits<T>::epsilon() * scale;
+}
+
+// Each clipped edge's normal n_j (Kahan), its sign of n_{j,z} (outer +, inner -, radial 0) and its ellipse.
+template <class T> struct ClippedEdges {
+  std::array<int, kMaxClippedVertices> sign{};
+  std::array<EdgeEllipse<T>, kMaxClippedVertices> ell{};
+  bool any_negative = false, any_positive = false;
+};
+template <class T> ClippedEdges<T> classify_edges(PolygonProjectedView<T>& v) {
+  ClippedEdges<T> c;
+  const int m = v.clipped.count;
+  for (int j = 0; j < m; ++j) {
+    v.edge_normals[j] = kahan_cross(v.clipped.v[j], v.clipped.v[(j + 1) % m]);
+    const T nz = v.edge_normals[j].z();  // = kahan_cross2 of the xy parts: the sorting comparison
+    c.sign[j] = nz > T(0) ? 1 : (nz < T(0) ? -1 : 0);
+    c.any_negative = c.any_negative || c.sign[j] < 0;
+    c.any_positive = c.any_positive || c.sign[j] > 0;
+    c.ell[j] = edge_ellipse(safe_normalized(v.edge_normals[j]));
+  }
+  return c;
+}
+
+// The xy part of clipped vertex i (modulo the count).
+template <class T> Vec2<T> clipped_xy(const PolygonProjectedView<T>& v, int i) {
+  const int m = v.clipped.count;
+  return Vec2<T>(v.clipped.v[(i % m + m) % m].x(), v.clipped.v[(i % m + m) % m].y());
+}
+
+// Sec. 3.1, Fig. 3a: one sector per edge. Its sine s0 x s1 is n_{j,z} >= 0 by construction.
+template <class T, bool kBiased> void central_sectors(PolygonProjectedView<T>& v, const ClippedEdges<T>& edges) {
+  const int m = v.clipped.count;
+  for (int j = 0; j < m; ++j) {
+    ProjectedSector<T>& s = v.sectors[v.sector_count++];
+    s.s0 = clipped_xy(v, j), s.s1 = clipped_xy(v, j + 1), s.outer = edges.ell[j];
+    s.outer_a = v.clipped.v[j], s.outer_b = v.clipped.v[(j + 1) % m];
+    s.area = std::max(T(0), ellipse_sector_area<T, kBiased>(s.outer, s.s0, s.s1, v.edge_normals[j].z()));
+  }
+}
+
+// Fig. 3b: the clockwise end c and the counterclockwise end e of the outer chain, where the signs change between runs
+// of outer (+) and inner (-) edges, skipping edges of sign 0; the outermost where rounding leaves several runs.
+// False when there is no such pair.
+template <class T>
+bool outer_chain_ends(const PolygonProjectedView<T>& v, const ClippedEdges<T>& edges, int& c, int& e) {
+  const int m = v.clipped.count;
+  auto nonzero_sign = [&](int j, int step) {
+    for (int k = 1; k < m; ++k)
+      if (const int sg = edges.sign[((j + step * k) % m + m) % m]; sg != 0) return sg;
+    return 0;
+  };
+  c = -1, e = -1;
+  for (int j = 0; j < m; ++j) {
+    if (edges.sign[j] <= 0) continue;
+    if (nonzero_sign(j, -1) < 0 && (c < 0 || kahan_cross2(clipped_xy(v, c), clipped_xy(v, j)) < T(0))) c = j;
+    if (nonzero_sign(j, 1) < 0 && (e < 0 || kahan_cross2(clipped_xy(v, e), clipped_xy(v, j + 1)) > T(0)))
+      e = (j + 1) % m;
+  }
+  return !(c < 0 || e < 0 || c == e);
+}
+
+// Sec. 3.7, Fig. 3b: the decentral sectors, by merging the outer chain (forward from c to e) with the inner one
+// (backward from c to e) like the merge step of merge sort. False when the chains do not exist.
+template <class T, bool kBiased> bool decentral_sectors(PolygonProjectedView<T>& v, const ClippedEdges<T>& edges) {
+  const int m = v.clipped.count;
+  int c, e;
+  if (!outer_chain_ends(v, edges, c, e)) return false;
+  std::array<int, kMaxClippedVertices + 1> ov{}, oe{}, iv{}, ie{};
+  const int no = (e - c + m) % m, ni = m - no;
+  ov[0] = c, iv[0] = c;
+  for (int k = 0; k < no; ++k) oe[k] = (c + k) % m, ov[k + 1] = (c + k + 1) % m;
+  for (int k = 0; k < ni; ++k) ie[k] = (c - k - 1 + m) % m, iv[k + 1] = ie[k];
+  int a = 0, bi = 0;
+  Vec2<T> cur = clipped_xy(v, ov[0]);
+  while (a < no && bi < ni && v.sector_count < kMaxClippedVertices) {
+    const Vec2<T> next_o = clipped_xy(v, ov[a + 1]), next_i = clipped_xy(v, iv[bi + 1]);
+    const T order = kahan_cross2(next_o, next_i);
+    ProjectedSector<T>& s = v.sectors[v.sector_count++];
+    s.decentral = true;
+    s.outer = edges.ell[oe[a]], s.inner = edges.ell[ie[bi]];
+    s.outer_a = v.clipped.v[oe[a]], s.outer_b = v.clipped.v[(oe[a] + 1) % m];
+    s.inner_a = v.clipped.v[ie[bi]], s.inner_b = v.clipped.v[(ie[bi] + 1) % m];
+    s.s0 = cur;
+    if (order > T(0))
+      s.s1 = next_o, ++a;
+    else if (order < T(0))
+      s.s1 = next_i, ++bi;
+    else
+      s.s1 = next_o, ++a, ++bi;
+    cur = s.s1;
+    const T cross = kahan_cross2(s.s0, s.s1);
+    const T sine = cross > T(0) ? cross : T(0);  // a sector is at most 180 degrees: clamp rounding
+    s.area = std::max(T(0), area_between_ellipses<T, kBiased>(s, s.s0, s.s1, sine));
+  }
+  return true;
+}
+
+}  // namespace polygon_projected_detail
+
+// The per-light precomputation: the clipped polygon in the (flipped) shading frame (Sec. 3.1), its sectors (Fig. 3)
+// and A_Sigma. vertex_rounding: as for check_polygon (polygon.h).
 template <class T, bool kBiased = false>
 PolygonProjectedView<T> make_polygon_projected_view(const PolygonLightGeometry<T>& g,
                                                     T vertex_rounding = kPolygonVertexRounding<T>) {
+  using namespace polygon_projected_detail;
   PolygonProjectedView<T> v;
   const PolygonView<T> pv = make_polygon_view(g, vertex_rounding);
   if (!pv.valid()) return v.reason = pv.reason, v;
-  // Too small when below 64 eps of the coordinates' scale, in extent or in its image's width D |plane_distance| / d.
-  {
-    T extent = 0, scale = 0;
-    for (int i = 0; i < g.light.count; ++i) {
-      extent = std::max(extent, Vec3<T>(g.light.vertices[i] - g.light.vertices[0]).cwiseAbs().maxCoeff());
-      scale = std::max(scale, g.light.vertices[i].cwiseAbs().maxCoeff());
-    }
-    scale += g.shading.position.cwiseAbs().maxCoeff();
-    if (!(extent > T(64) * std::numeric_limits<T>::epsilon() * scale)) return v.reason = NoSample::kTooSmall, v;
-    T diameter = 0, nearest = std::numeric_limits<T>::infinity();
-    for (int i = 0; i < g.light.count; ++i) {
-      diameter = std::max(diameter, T(2) * Vec3<T>(g.light.vertices[i] - g.light.vertices[0]).stableNorm());
-      nearest = std::min(nearest, Vec3<T>(g.light.vertices[i] - g.shading.position).stableNorm());
-    }
-    const T h = std::abs(pv.plane_distance), d = std::max(h, nearest - diameter);
-    if (!(diameter * (h / d) > T(64) * std::numeric_limits<T>::epsilon() * scale))
-      return v.reason = NoSample::kTooSmall, v;
-  }
+  if (!resolved_by_coordinates(g, pv)) return v.reason = NoSample::kTooSmall, v;
   v.frame = pv.frame;
   v.flip_y = pv.plane_distance < T(0);
-  {
-    const int n = polygon_inward_planes(g, pv, v.inward.data());
-    v.inward[n] = pv.normal;
-    v.planes = n + 1;
-  }
+  const int n = polygon_inward_planes(g, pv, v.inward.data());
+  v.inward[n] = pv.normal;
+  v.planes = n + 1;
   LocalPolygon<T> local = pv.local;
   if (v.flip_y)
     for (int i = 0; i < local.count; ++i) local.v[i].y() = -local.v[i].y();
@@ -344,76 +444,17 @@ PolygonProjectedView<T> make_polygon_projected_view(const PolygonLightGeometry<T
   bool above = false;
   for (int i = 0; i < m; ++i) above = above || v.clipped.v[i].z() > T(0);
   if (m < 3 || !above) return v.reason = NoSample::kBelowHorizon, v;
-
-  std::array<int, kMaxClippedVertices> sign{};
-  std::array<EdgeEllipse<T>, kMaxClippedVertices> ell{};
-  bool any_negative = false, any_positive = false;
-  for (int j = 0; j < m; ++j) {
-    v.edge_normals[j] = kahan_cross(v.clipped.v[j], v.clipped.v[(j + 1) % m]);
-    const T nz = v.edge_normals[j].z();  // = kahan_cross2 of the xy parts: the sorting comparison
-    sign[j] = nz > T(0) ? 1 : (nz < T(0) ? -1 : 0);
-    any_negative = any_negative || sign[j] < 0;
-    any_positive = any_positive || sign[j] > 0;
-    ell[j] = edge_ellipse(safe_normalized(v.edge_normals[j]));
-  }
-  if (!any_positive) return v.reason = NoSample::kTooSmall, v;  // no projected area representable
-  auto xy = [&](int i) { return Vec2<T>(v.clipped.v[(i % m + m) % m].x(), v.clipped.v[(i % m + m) % m].y()); };
+  const ClippedEdges<T> edges = classify_edges(v);
+  if (!edges.any_positive) return v.reason = NoSample::kTooSmall, v;  // no projected area representable
   // A vertex at the zenith: the central decomposition is exact, and an n_z < 0 elsewhere is noise.
   bool zenith_vertex = false;
   for (int i = 0; i < m; ++i)
     zenith_vertex = zenith_vertex || (v.clipped.v[i].x() == T(0) && v.clipped.v[i].y() == T(0));
-  v.central = !any_negative || zenith_vertex || winds_around_zenith(v.clipped);
-  if (v.central) {
-    // Sec. 3.1, Fig. 3a: one sector per edge. Its sine s0 x s1 is n_{j,z} >= 0 by construction.
-    for (int j = 0; j < m; ++j) {
-      ProjectedSector<T>& s = v.sectors[v.sector_count++];
-      s.s0 = xy(j), s.s1 = xy(j + 1), s.outer = ell[j];
-      s.outer_a = v.clipped.v[j], s.outer_b = v.clipped.v[(j + 1) % m];
-      s.area = std::max(T(0), ellipse_sector_area<T, kBiased>(s.outer, s.s0, s.s1, v.edge_normals[j].z()));
-    }
-  } else {
-    // Fig. 3b: the outer chain's ends c, e (sign changes, skipping 0; the outermost where rounding leaves several
-    // runs), then the chains merged: outer forward, inner backward.
-    auto nonzero_sign = [&](int j, int step) {
-      for (int k = 1; k < m; ++k)
-        if (const int sg = sign[((j + step * k) % m + m) % m]; sg != 0) return sg;
-      return 0;
-    };
-    int c = -1, e = -1;
-    for (int j = 0; j < m; ++j) {
-      if (sign[j] <= 0) continue;
-      if (nonzero_sign(j, -1) < 0 && (c < 0 || kahan_cross2(xy(c), xy(j)) < T(0))) c = j;
-      if (nonzero_sign(j, 1) < 0 && (e < 0 || kahan_cross2(xy(e), xy(j + 1)) > T(0))) e = (j + 1) % m;
-    }
-    if (c < 0 || e < 0 || c == e) return v.reason = NoSample::kTooSmall, v;
-    std::array<int, kMaxClippedVertices + 1> ov{}, oe{}, iv{}, ie{};
-    const int no = (e - c + m) % m, ni = m - no;
-    ov[0] = c, iv[0] = c;
-    for (int k = 0; k < no; ++k) oe[k] = (c + k) % m, ov[k + 1] = (c + k + 1) % m;
-    for (int k = 0; k < ni; ++k) ie[k] = (c - k - 1 + m) % m, iv[k + 1] = ie[k];
-    int a = 0, bi = 0;
-    Vec2<T> cur = xy(ov[0]);
-    while (a < no && bi < ni && v.sector_count < kMaxClippedVertices) {
-      const Vec2<T> next_o = xy(ov[a + 1]), next_i = xy(iv[bi + 1]);
-      const T order = kahan_cross2(next_o, next_i);
-      ProjectedSector<T>& s = v.sectors[v.sector_count++];
-      s.decentral = true;
-      s.outer = ell[oe[a]], s.inner = ell[ie[bi]];
-      s.outer_a = v.clipped.v[oe[a]], s.outer_b = v.clipped.v[(oe[a] + 1) % m];
-      s.inner_a = v.clipped.v[ie[bi]], s.inner_b = v.clipped.v[(ie[bi] + 1) % m];
-      s.s0 = cur;
-      if (order > T(0))
-        s.s1 = next_o, ++a;
-      else if (order < T(0))
-        s.s1 = next_i, ++bi;
-      else
-        s.s1 = next_o, ++a, ++bi;
-      cur = s.s1;
-      const T cross = kahan_cross2(s.s0, s.s1);
-      const T sine = cross > T(0) ? cross : T(0);  // a sector is at most 180 degrees: clamp rounding
-      s.area = std::max(T(0), area_between_ellipses<T, kBiased>(s, s.s0, s.s1, sine));
-    }
-  }
+  v.central = !edges.any_negative || zenith_vertex || winds_around_zenith(v.clipped);
+  if (v.central)
+    central_sectors<T, kBiased>(v, edges);
+  else if (!decentral_sectors<T, kBiased>(v, edges))
+    return v.reason = NoSample::kTooSmall, v;
   T total = 0;
   for (int k = 0; k < v.sector_count; ++k) total += v.sectors[k].area;
   // The density cos / A_Sigma must be representable too.

@@ -34,9 +34,124 @@ template <class T> Vec3<T> unit_difference(const Vec3<T>& pa, T na, const Vec3<T
   return (e - (pa / na) * dn) / nb;
 }
 
-// split_wide_edges (Section 5's sampler): fan edges wider than 120 degrees get their midpoints as vertices.
+namespace polygon_fan_detail {
+
+// The unclipped fan: the (flattened, PolygonView::lift) light's vertices from x, wound positively, vertex 0 first.
+template <class T>
+void unclipped_fan(const PolygonLightGeometry<T>& g, const PolygonView<T>& pv, bool reverse, PolygonFanView<T>& f) {
+  const int m = g.light.count;
+  f.count = m;
+  const Vec3<T>& nh = pv.plane_normal;
+  for (int k = 0; k < m; ++k) {
+    const int src = reverse ? (m - k) % m : k;  // keeps vertex 0 first
+    f.p[k] = g.light.vertices[src] - g.shading.position - pv.lift[src] * nh;
+    f.e[k] = g.light.vertices[src] - g.light.vertices[0] - (pv.lift[src] - pv.lift[0]) * nh;
+  }
+}
+
+// The fan of the light clipped to the upper hemisphere; false when nothing is strictly above the horizon. A horizon
+// edge wider than 90 degrees (at most one) gets its midpoint n x (u_b - u_a) as a vertex and the root: no fan
+// triangle then joins its nearly antipodal ends by a great circle of rounding noise.
+template <class T>
+bool clipped_fan(const PolygonView<T>& pv, bool reverse, PolygonFanView<T>& f, bool& horizon_rooted) {
+  const LocalPolygon<T> c = clip_to_upper_hemisphere(pv.local);
+  bool strictly_above = false;
+  for (int i = 0; i < c.count; ++i) strictly_above = strictly_above || c.v[i].z() > T(0);
+  if (c.count < 3 || !strictly_above) return false;
+  std::array<Vec3<T>, kMaxFanVertices> q;
+  int nq = 0, root = 0;
+  const Vec3<T> light_normal = pv.frame.to_local(pv.plane_normal);
+  for (int i = 0; i < c.count; ++i) {
+    const Vec3<T>&a = c.v[i], &b = c.v[(i + 1) % c.count];
+    q[nq++] = a;
+    if (a.z() != T(0) || b.z() != T(0) || nq + (c.count - 1 - i) >= kMaxFanVertices) continue;  // room for the rest
+    const Vec3<T> ua = safe_normalized(a), ub = safe_normalized(b);
+    if (!(ua.dot(ub) < T(0))) continue;
+    Vec3<T> mid = safe_normalized(Vec3<T>(ua.y() - ub.y(), ub.x() - ua.x(), T(0)));
+    if (light_normal.dot(mid) * pv.plane_distance < T(0)) mid = -mid;
+    if (!mid.isZero()) root = nq, q[nq++] = mid * ((a.norm() + b.norm()) / T(2)), horizon_rooted = true;
+  }
+  f.count = nq;
+  for (int k = 0; k < nq; ++k) f.p[k] = pv.frame.to_world(q[reverse ? (root - k + nq) % nq : (root + k) % nq]);
+  for (int k = 0; k < nq; ++k) f.e[k] = f.p[k] - f.p[0];
+  return true;
+}
+
+// u_k and |p_k| (and e_k = p_k - p_0 if asked) of the fan's vertices; false for a vertex without a direction.
+template <class T> bool fan_directions(PolygonFanView<T>& f, bool edges_from_p0) {
+  for (int k = 0; k < f.count; ++k) {
+    if (edges_from_p0) f.e[k] = f.p[k] - f.p[0];
+    f.u[k] = safe_normalized(f.p[k]);
+    f.len[k] = f.p[k].stableNorm();
+    if (f.u[k].isZero()) return false;
+  }
+  return true;
+}
+
+// The cone's planes: the light's own edge planes (polygon_inward_planes), the horizon if clipped, then the light's
+// plane.
+template <class T> void fan_cone(const PolygonLightGeometry<T>& g, const PolygonView<T>& pv, bool reverse, bool clipped,
+                                 PolygonFanView<T>& f) {
+  const int m = polygon_inward_planes(g, pv, f.inward.data());
+  if (!clipped) {
+    f.inward[m] = reverse ? Vec3<T>(-pv.plane_normal) : pv.plane_normal;
+    f.planes = m + 1;
+  } else {
+    const T orient = reverse ? T(-1) : T(1);
+    f.inward[m] = pv.normal;  // m <= kMaxPolygonVertices = kMaxFanVertices - 2
+    f.inward[m + 1] = orient * pv.plane_normal;
+    f.planes = m + 2;
+  }
+}
+
+// The midpoint of the fan edge from u_k to u_k1 (unit), m x (u_k - u_k1) with m the cone's edge plane that holds both
+// ends best, signed to lie on the short arc and on the light's side of the cone's last plane (by the larger test);
+// zero when there is none.
+template <class T> Vec3<T> wide_edge_midpoint(const PolygonFanView<T>& f, int k, int k1) {
+  int best = -1;
+  T best_residual = std::numeric_limits<T>::infinity();
+  for (int j = 0; j + 1 < f.planes; ++j) {
+    const Vec3<T> mj = safe_normalized(f.inward[j]);
+    const T r = std::max(std::abs(mj.dot(f.u[k])), std::abs(mj.dot(f.u[k1])));
+    if (r < best_residual) best_residual = r, best = j;
+  }
+  if (best < 0) return Vec3<T>::Zero();
+  Vec3<T> mid = safe_normalized(kahan_cross(safe_normalized(f.inward[best]), Vec3<T>(f.u[k] - f.u[k1])));
+  if (mid.isZero()) return mid;
+  const T by_arc = mid.dot(Vec3<T>(f.u[k] + f.u[k1])), by_side = mid.dot(safe_normalized(f.inward[f.planes - 1]));
+  if ((std::abs(by_arc) >= std::abs(by_side) ? by_arc : by_side) < T(0)) mid = -mid;
+  return mid;
+}
+
+// Edges wider than 120 degrees (at most two) get their midpoints as vertices, the fan rooted at the first (unless it
+// is rooted at a horizon midpoint): no fan triangle then has Eq. 13's G1 + G2 as a difference of numbers near 2.
+// False for a vertex without a direction.
+template <class T> bool split_wide_fan_edges(PolygonFanView<T>& f, bool horizon_rooted) {
+  std::array<Vec3<T>, kMaxFanVertices> q;
+  int nq = 0, root = -1;
+  for (int k = 0; k < f.count; ++k) {
+    const int k1 = (k + 1) % f.count;
+    q[nq++] = f.p[k];
+    if (!(f.u[k].dot(f.u[k1]) < T(-0.5)) || nq + (f.count - 1 - k) >= kMaxFanVertices) continue;
+    const Vec3<T> mid = wide_edge_midpoint(f, k, k1);
+    if (mid.isZero()) continue;
+    if (root < 0) root = nq;
+    q[nq++] = mid * ((f.len[k] + f.len[k1]) / T(2));
+  }
+  if (nq == f.count) return true;
+  if (horizon_rooted || root < 0) root = 0;
+  for (int k = 0; k < nq; ++k) f.p[k] = q[(root + k) % nq];
+  f.count = nq;
+  return fan_directions(f, true);
+}
+
+}  // namespace polygon_fan_detail
+
+// The polygon's fan as seen from the shading point, clipped to the upper hemisphere or not. split_wide_edges
+// (Section 5's sampler): fan edges wider than 120 degrees get their midpoints as vertices.
 template <class T>
 PolygonFanView<T> make_polygon_fan_view(const PolygonLightGeometry<T>& g, bool clipped, bool split_wide_edges = false) {
+  using namespace polygon_fan_detail;
   PolygonFanView<T> f;
   const PolygonView<T> pv = make_polygon_view(g);
   if (!pv.valid()) return f.reason = pv.reason, f;
@@ -47,94 +162,13 @@ PolygonFanView<T> make_polygon_fan_view(const PolygonLightGeometry<T>& g, bool c
   if (!above) return f.reason = NoSample::kBelowHorizon, f;
   const bool reverse = pv.plane_distance < T(0);
   bool horizon_rooted = false;  // the clipped fan is rooted at a horizon edge's midpoint
-  if (!clipped) {
-    const int m = g.light.count;
-    f.count = m;
-    // The flattened light's vertices (PolygonView::lift; zero lifts for a planar light).
-    const Vec3<T>& nh = pv.plane_normal;
-    for (int k = 0; k < m; ++k) {
-      const int src = reverse ? (m - k) % m : k;  // keeps vertex 0 first
-      f.p[k] = g.light.vertices[src] - g.shading.position - pv.lift[src] * nh;
-      f.e[k] = g.light.vertices[src] - g.light.vertices[0] - (pv.lift[src] - pv.lift[0]) * nh;
-    }
-  } else {
-    const LocalPolygon<T> c = clip_to_upper_hemisphere(pv.local);
-    bool strictly_above = false;
-    for (int i = 0; i < c.count; ++i) strictly_above = strictly_above || c.v[i].z() > T(0);
-    if (c.count < 3 || !strictly_above) return f.reason = NoSample::kBelowHorizon, f;
-    // A horizon edge wider than 90 degrees (at most one) gets its midpoint n x (u_b - u_a) as a vertex and the root:
-    // no fan triangle then joins its nearly antipodal ends by a great circle of rounding noise.
-    std::array<Vec3<T>, kMaxFanVertices> q;
-    int nq = 0, root = 0;
-    const Vec3<T> light_normal = pv.frame.to_local(pv.plane_normal);
-    for (int i = 0; i < c.count; ++i) {
-      const Vec3<T>&a = c.v[i], &b = c.v[(i + 1) % c.count];
-      q[nq++] = a;
-      if (a.z() != T(0) || b.z() != T(0) || nq + (c.count - 1 - i) >= kMaxFanVertices) continue;  // room for the rest
-      const Vec3<T> ua = safe_normalized(a), ub = safe_normalized(b);
-      if (!(ua.dot(ub) < T(0))) continue;
-      Vec3<T> mid = safe_normalized(Vec3<T>(ua.y() - ub.y(), ub.x() - ua.x(), T(0)));
-      if (light_normal.dot(mid) * pv.plane_distance < T(0)) mid = -mid;
-      if (!mid.isZero()) root = nq, q[nq++] = mid * ((a.norm() + b.norm()) / T(2)), horizon_rooted = true;
-    }
-    f.count = nq;
-    for (int k = 0; k < nq; ++k) f.p[k] = pv.frame.to_world(q[reverse ? (root - k + nq) % nq : (root + k) % nq]);
-    for (int k = 0; k < nq; ++k) f.e[k] = f.p[k] - f.p[0];
-  }
-  for (int k = 0; k < f.count; ++k) {
-    f.u[k] = safe_normalized(f.p[k]);
-    f.len[k] = f.p[k].stableNorm();
-    if (f.u[k].isZero()) return f.reason = NoSample::kNonFinite, f;
-  }
-  if (!clipped) {
-    // The light's own edge planes (polygon_inward_planes), then the light's plane.
-    const int m = polygon_inward_planes(g, pv, f.inward.data());
-    f.inward[m] = reverse ? Vec3<T>(-pv.plane_normal) : pv.plane_normal;
-    f.planes = m + 1;
-  } else {
-    const int m = polygon_inward_planes(g, pv, f.inward.data());
-    const T orient = reverse ? T(-1) : T(1);
-    f.inward[m] = pv.normal;  // m <= kMaxPolygonVertices = kMaxFanVertices - 2
-    f.inward[m + 1] = orient * pv.plane_normal;
-    f.planes = m + 2;
-  }
-  if (split_wide_edges) {
-    // Edges wider than 120 degrees (at most two) get midpoints m x (u_a - u_b), m the edge plane holding both ends
-    // best, the first as root: no fan triangle then has Eq. 13's G1 + G2 as a difference of numbers near 2.
-    std::array<Vec3<T>, kMaxFanVertices> q;
-    int nq = 0, root = -1;
-    for (int k = 0; k < f.count; ++k) {
-      const int k1 = (k + 1) % f.count;
-      q[nq++] = f.p[k];
-      if (!(f.u[k].dot(f.u[k1]) < T(-0.5)) || nq + (f.count - 1 - k) >= kMaxFanVertices) continue;
-      int best = -1;
-      T best_residual = std::numeric_limits<T>::infinity();
-      for (int j = 0; j + 1 < f.planes; ++j) {
-        const Vec3<T> mj = safe_normalized(f.inward[j]);
-        const T r = std::max(std::abs(mj.dot(f.u[k])), std::abs(mj.dot(f.u[k1])));
-        if (r < best_residual) best_residual = r, best = j;
-      }
-      if (best < 0) continue;
-      Vec3<T> mid = safe_normalized(kahan_cross(safe_normalized(f.inward[best]), Vec3<T>(f.u[k] - f.u[k1])));
-      if (mid.isZero()) continue;
-      // The midpoint's sign: on the short arc and on the light's side of the last plane, by the larger test.
-      const T by_arc = mid.dot(Vec3<T>(f.u[k] + f.u[k1])), by_side = mid.dot(safe_normalized(f.inward[f.planes - 1]));
-      if ((std::abs(by_arc) >= std::abs(by_side) ? by_arc : by_side) < T(0)) mid = -mid;
-      if (root < 0) root = nq;
-      q[nq++] = mid * ((f.len[k] + f.len[k1]) / T(2));
-    }
-    if (nq > f.count) {
-      if (horizon_rooted || root < 0) root = 0;
-      for (int k = 0; k < nq; ++k) f.p[k] = q[(root + k) % nq];
-      f.count = nq;
-      for (int k = 0; k < f.count; ++k) {
-        f.e[k] = f.p[k] - f.p[0];
-        f.u[k] = safe_normalized(f.p[k]);
-        f.len[k] = f.p[k].stableNorm();
-        if (f.u[k].isZero()) return f.reason = NoSample::kNonFinite, f;
-      }
-    }
-  }
+  if (!clipped)
+    unclipped_fan(g, pv, reverse, f);
+  else if (!clipped_fan(pv, reverse, f, horizon_rooted))
+    return f.reason = NoSample::kBelowHorizon, f;
+  if (!fan_directions(f, false)) return f.reason = NoSample::kNonFinite, f;
+  fan_cone(g, pv, reverse, clipped, f);
+  if (split_wide_edges && !split_wide_fan_edges(f, horizon_rooted)) return f.reason = NoSample::kNonFinite, f;
   return f;
 }
 

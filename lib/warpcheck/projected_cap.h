@@ -197,10 +197,10 @@ template <class T> struct Piece {
 
 template <class T> struct ProjectedCapView {
   NoSample reason = NoSample::kNone;
-  int which_case = 4;       // 1: entirely above, 2: mostly above, 3: mostly below (Sec. 3.2)
-  SphereView<T> sphere;     // validation, distance, the cap (shared with the sphere kernels)
-  Vec3<T> x, y, z;          // local frame (Alg. 1)
-  T h = T(0), w_dx = T(0);  // n.w_d and the horizontal length of w_d
+  int which_case = 4;    // 1: entirely above, 2: mostly above, 3: mostly below (Sec. 3.2)
+  SphereView<T> sphere;  // validation, distance, the cap (shared with the sphere kernels)
+  Vec3<T> x = Vec3<T>::Zero(), y = Vec3<T>::Zero(), z = Vec3<T>::Zero();  // local frame (Alg. 1)
+  T h = T(0), w_dx = T(0);                                                // n.w_d and the horizontal length of w_d
   T r_x = T(0), r_y = T(0), r_z = T(0), c_x = T(0), c_z = T(0), t_x = T(0), t_y = T(0), v = T(0);
   // Pieces: ellipse (Cases 1-2, u0 in [0, tau)), mirrored disk (Case 2, u0 in [tau, 1]), lune (Case 3).
   T area_e = T(0), area_e_unit = T(0), area_d = T(0), total = T(0), tau = T(0);
@@ -251,20 +251,14 @@ template <class T> int unit_scale_geometry(const SphereLightGeometry<T>& g, Sphe
 
 namespace projected_cap_detail {
 template <class T, CutDiskInverse M> int pieces(const ProjectedCapView<T>& p, std::array<Piece<T>, 2>& out);
-}  // namespace projected_cap_detail
 
-template <class T> ProjectedCapView<T> make_projected_cap_view(const SphereLightGeometry<T>& g) {
-  ProjectedCapView<T> p;
-  SphereLightGeometry<T> unit;
-  const int scale_exponent = projected_cap_detail::unit_scale_geometry(g, unit);
-  p.sphere = make_sphere_view(unit);
-  if (!p.sphere.valid()) return p.reason = p.sphere.reason, p;
-  p.sphere.distance = std::ldexp(p.sphere.distance, scale_exponent);  // |c - x| in the caller's units
+// Alg. 1's local frame: z = n, x the horizontal part of w_d as n x (w_d x n), orthogonal to n to rounding even for a
+// light overhead (unlike Gram-Schmidt); replaced only when exactly 0 (a threshold would differ between float and long
+// double). Sets z, x, y, h = n.w_d and w_dx, the horizontal part's length.
+template <class T> void local_frame(ProjectedCapView<T>& p) {
   const SphereView<T>& s = p.sphere;
   const Vec3<T> wd = s.frame.z;
   p.z = s.normal;
-  // The horizontal part of w_d as n x (w_d x n), orthogonal to n to rounding even for a light overhead (unlike
-  // Gram-Schmidt); replaced only when exactly 0 (a threshold would differ between float and long double).
   const T h_raw = p.z.dot(wd);
   const Vec3<T> horizontal = p.z.cross(Vec3<T>(wd.cross(p.z)));
   p.h = std::clamp(h_raw, T(-1), T(1));
@@ -279,8 +273,65 @@ template <class T> ProjectedCapView<T> make_projected_cap_view(const SphereLight
     p.x = Frame<T>::from_z(p.z).x;  // overhead: any horizontal x
   }
   p.y = p.z.cross(p.x);
-  p.r_y = std::sqrt(s.sin2_theta_max);
-  p.v = s.cos_theta_max;
+}
+
+// Case 1 (Alg. 3): the whole ellipse; t_x >= 1 is never needed.
+template <class T> void case1_geometry(ProjectedCapView<T>& p) {
+  p.which_case = 1;
+  p.area_e_unit = kPi<T>;
+  p.area_e = p.r_x * p.r_y * kPi<T>;
+  p.total = p.area_e;
+  p.tau = T(1);
+}
+
+// Case 2 (Alg. 2): the ellipse piece up to X_t and the mirrored disk piece; chord2 = r_y^2 - h^2 > 0.
+// A_E' = pi/2 + A(X_t) = pi - C(theta_E), X_t = cos(theta_E) = v h / (r_y w_dx).
+template <class T> void case2_geometry(ProjectedCapView<T>& p, T chord2) {
+  const T h = p.h, ry = p.r_y, v = p.v;
+  p.which_case = 2;
+  p.right_e_unit = cut_disk_area_from_angle(std::atan2(std::sqrt(chord2), v * h));
+  p.area_e_unit = kPi<T> - p.right_e_unit;
+  // X_t and its half-height sqrt(1 - X_t^2).
+  const CutDiskPreimage<T> qe =
+      cut_disk_preimage<T, CutDiskInverse::kQuintic>(v * h / (ry * p.w_dx), std::sqrt(chord2) / (ry * p.w_dx));
+  p.quintic_area_e_unit = qe.left_area;
+  p.quintic_right_e_unit = qe.right_area;
+  p.area_e = p.r_x * p.r_y * p.area_e_unit;
+  p.total = p.area_e + p.area_d;
+  // Both areas can underflow to 0: tau only for a positive total, which the caller tests.
+  p.tau = p.total > T(0) ? p.area_e / p.total : T(0);
+}
+
+// Case 3 (Alg. 4): the lune; chord2 = r_y^2 - h^2 > 0, h < 0.
+template <class T> void case3_geometry(ProjectedCapView<T>& p, T chord2) {
+  const T h = p.h, ry = p.r_y, v = p.v;
+  p.which_case = 3;
+  p.rz_minus_cz = p.w_dx * ry - h * v;
+  p.top = chord2 / p.rz_minus_cz;                    // c_z + r_z
+  p.k = std::sqrt(chord2) * p.w_dx / p.rz_minus_cz;  // (c_z + r_z) / t_y
+  // 1 - m = -2 h v / (r_z - c_z), 1 - k^2 = q (2 v w_dx r_y / (r_z - c_z) + q (v^2 + w_dx^2)), q = -h / (r_z -
+  // c_z): terms >= 0 for h < 0, no square of r_z - c_z (it underflows).
+  p.sy_m = p.top / p.rz_minus_cz;
+  p.sy_one_minus_m = T(-2) * h * v / p.rz_minus_cz;
+  const T q3 = -h / p.rz_minus_cz;
+  p.one_minus_k2 = q3 * (T(2) * v * p.w_dx * (ry / p.rz_minus_cz) + q3 * (v * v + p.w_dx * p.w_dx));
+  p.total = p.area_d;
+  p.tau = T(0);
+}
+}  // namespace projected_cap_detail
+
+// ComputeGeometry (Alg. 1) and the case's pieces (Alg. 2-4), once per light.
+template <class T> ProjectedCapView<T> make_projected_cap_view(const SphereLightGeometry<T>& g) {
+  using namespace projected_cap_detail;
+  ProjectedCapView<T> p;
+  SphereLightGeometry<T> unit;
+  const int scale_exponent = unit_scale_geometry(g, unit);
+  p.sphere = make_sphere_view(unit);
+  if (!p.sphere.valid()) return p.reason = p.sphere.reason, p;
+  p.sphere.distance = std::ldexp(p.sphere.distance, scale_exponent);  // |c - x| in the caller's units
+  local_frame(p);
+  p.r_y = std::sqrt(p.sphere.sin2_theta_max);
+  p.v = p.sphere.cos_theta_max;
   p.r_x = p.h * p.r_y, p.r_z = p.w_dx * p.r_y, p.c_x = p.w_dx * p.v, p.c_z = p.h * p.v;
   const T h = p.h, ry = p.r_y, v = p.v;
   if (h <= -ry) return p.reason = NoSample::kBelowHorizon, p;  // Case 4 (make_sphere_view catches it first)
@@ -290,51 +341,20 @@ template <class T> ProjectedCapView<T> make_projected_cap_view(const SphereLight
   p.one_minus_cx = (h * h + p.w_dx * p.w_dx * ry * ry) / (T(1) + p.w_dx * v);
   // Cases 2-3 divide by w_dx (> v >= 0 when h < r_y); w_dx = 0 with h < r_y is h = 1 against r_y = 1: Case 1.
   if (h >= ry || !(p.w_dx > T(0))) {
-    // Case 1 (Alg. 3): the whole ellipse; t_x >= 1 is never needed.
-    p.which_case = 1;
-    p.area_e_unit = kPi<T>;
-    p.area_e = p.r_x * p.r_y * kPi<T>;
-    p.total = p.area_e;
-    p.tau = T(1);
+    case1_geometry(p);
   } else {
-    // chord2 = r_y^2 - h^2 > 0 (above)
     p.t_x = v / p.w_dx;  // w_dx >= v > 0 here
     p.t_y = std::sqrt(chord2) / p.w_dx;
     p.area_d = cut_disk_area_from_angle(std::atan2(std::sqrt(chord2), v));  // pi/2 - A(t_x)
     p.quintic_area_d = cut_disk_preimage<T, CutDiskInverse::kQuintic>(-p.t_x, p.t_y).left_area;
-    if (h >= T(0)) {
-      // Case 2 (Alg. 2). A_E' = pi/2 + A(X_t) = pi - C(theta_E), X_t = cos(theta_E) = v h / (r_y w_dx).
-      p.which_case = 2;
-      p.right_e_unit = cut_disk_area_from_angle(std::atan2(std::sqrt(chord2), v * h));
-      p.area_e_unit = kPi<T> - p.right_e_unit;
-      // X_t and its half-height sqrt(1 - X_t^2).
-      const CutDiskPreimage<T> qe =
-          cut_disk_preimage<T, CutDiskInverse::kQuintic>(v * h / (ry * p.w_dx), std::sqrt(chord2) / (ry * p.w_dx));
-      p.quintic_area_e_unit = qe.left_area;
-      p.quintic_right_e_unit = qe.right_area;
-      p.area_e = p.r_x * p.r_y * p.area_e_unit;
-      p.total = p.area_e + p.area_d;
-      // Both areas can underflow to 0: tau only for a positive total, which is tested below.
-      p.tau = p.total > T(0) ? p.area_e / p.total : T(0);
-    } else {
-      // Case 3 (Alg. 4).
-      p.which_case = 3;
-      p.rz_minus_cz = p.w_dx * ry - h * v;
-      p.top = chord2 / p.rz_minus_cz;                    // c_z + r_z
-      p.k = std::sqrt(chord2) * p.w_dx / p.rz_minus_cz;  // (c_z + r_z) / t_y
-      // 1 - m = -2 h v / (r_z - c_z), 1 - k^2 = q (2 v w_dx r_y / (r_z - c_z) + q (v^2 + w_dx^2)), q = -h / (r_z -
-      // c_z): terms >= 0 for h < 0, no square of r_z - c_z (it underflows).
-      p.sy_m = p.top / p.rz_minus_cz;
-      p.sy_one_minus_m = T(-2) * h * v / p.rz_minus_cz;
-      const T q3 = -h / p.rz_minus_cz;
-      p.one_minus_k2 = q3 * (T(2) * v * p.w_dx * (ry / p.rz_minus_cz) + q3 * (v * v + p.w_dx * p.w_dx));
-      p.total = p.area_d;
-      p.tau = T(0);
-    }
+    if (h >= T(0))
+      case2_geometry(p, chord2);
+    else
+      case3_geometry(p, chord2);
   }
   if (!(p.total > T(0)) || !std::isfinite(p.total)) return p.reason = NoSample::kTooSmall, p;
   if constexpr (std::is_same_v<T, float>)
-    p.quintic_piece_count = projected_cap_detail::pieces<T, CutDiskInverse::kQuintic>(p, p.quintic_pieces);
+    p.quintic_piece_count = pieces<T, CutDiskInverse::kQuintic>(p, p.quintic_pieces);
   return p;
 }
 

@@ -28,8 +28,9 @@ template <class T> struct SphereLightGeometry {
 // Per-light precomputation shared by both sphere kernels.
 template <class T> struct SphereView {
   NoSample reason = NoSample::kNone;
-  Vec3<T> normal;              // unit shading normal
-  Frame<T> frame;              // z: unit direction from the shading point to the centre
+  Vec3<T> normal = Vec3<T>::Zero();  // unit shading normal
+  // z: the unit direction from the shading point to the centre
+  Frame<T> frame = Frame<T>::from_z(Vec3<T>(T(0), T(0), T(1)));
   T distance = T(0);           // d = |c - x|
   T sin2_theta_max = T(0);     // (r / d)^2
   T one_minus_cos_max = T(0);  // 1 - cos(theta_max), computed without cancellation

@@ -77,6 +77,33 @@ template <class T> T pivot_jacobian(const Vec3<T>& w, const Vec3<T>& rp, T k) {
 }
 template <class T> T pivot_jacobian(const Vec3<T>& w, const Vec3<T>& rp) { return pivot_jacobian(w, rp, pivot_k(rp)); }
 
+namespace sptd_detail {
+
+// Fig. 3 (1): the unit direction t in the plane through the origin, w_c and r_p, orthogonal to w_c, by two
+// Gram-Schmidt passes; any such t where it is rounding noise (every plane through w_c is then one of symmetry).
+template <class T> Vec3<T> boundary_plane_direction(const Vec3<T>& wc, const Vec3<T>& rp) {
+  Vec3<T> t = rp - rp.dot(wc) * wc;
+  t -= t.dot(wc) * wc;
+  const T tn = t.stableNorm();
+  constexpr T e = std::numeric_limits<T>::epsilon();
+  return tn > T(64) * e * rp.stableNorm() && tn > std::numeric_limits<T>::min() / e ? Vec3<T>(t / tn)
+                                                                                    : Frame<T>::from_z(wc).x;
+}
+
+// The image axis minus r_p from the boundary points' offsets o_i = r_p - p_i (|o_i| = d_i): q_i = g_i - r_p =
+// k o_i / d_i^2, h = (q1 + q2) / 2, m = r_p + h, and axis - r_p = h + m (1 - |m|) / |m| with 1 - |m|^2 =
+// |q1 - q2|^2 / 4 (docs/derivations/sptd.md). False where it is not representable.
+template <class T>
+bool image_axis_offset(const Vec3<T>& rp, T k, const Vec3<T>& o1, const Vec3<T>& o2, T d1, T d2, Vec3<T>& off) {
+  const Vec3<T> q1 = (k / (d1 * d1)) * o1, q2 = (k / (d2 * d2)) * o2;
+  const Vec3<T> h = (q1 + q2) / T(2), m = rp + h;
+  const T mn = m.norm();
+  off = h + m * ((q1 - q2).squaredNorm() / T(4) / (T(1) + mn) / mn);
+  return all_finite(off) && Vec3<T>(rp + off).norm() > T(0);
+}
+
+}  // namespace sptd_detail
+
 // Eqs. 6-7, the axis as the oriented in-plane bisector: the cap g(C). axis_minus_pivot: if given, the image axis
 // minus r_p to its own rounding, for a small image (below 30 degrees; *relative says whether it was set), whose
 // unit vectors near r_p g would stretch by k / |w - r_p|^2 (docs/derivations/sptd.md).
@@ -85,14 +112,7 @@ template <class T> Cap<T> pivot_transform_cap(const Cap<T>& c, const Vec3<T>& rp
   if (relative) *relative = false;
   if (c.one_minus_cos >= T(2)) return Cap<T>{c.axis, T(2)};  // the whole sphere maps onto itself
   const Vec3<T>& wc = c.axis;
-  // The plane through the origin, w_c and r_p (Fig. 3 (1)), by two Gram-Schmidt passes; any plane through w_c where
-  // t is rounding noise (every such plane is one of symmetry).
-  Vec3<T> t = rp - rp.dot(wc) * wc;
-  t -= t.dot(wc) * wc;
-  const T tn = t.stableNorm();
-  constexpr T e = std::numeric_limits<T>::epsilon();
-  t = tn > T(64) * e * rp.stableNorm() && tn > std::numeric_limits<T>::min() / e ? Vec3<T>(t / tn)
-                                                                                 : Frame<T>::from_z(wc).x;
+  const Vec3<T> t = sptd_detail::boundary_plane_direction(wc, rp);
   const T omc = c.one_minus_cos;
   const T cos_a = T(1) - omc, sin_a = std::sqrt(std::max(T(0), omc * (T(2) - omc)));
   // Fig. 3 (2)-(3): the boundary points in that plane and their images.
@@ -123,24 +143,17 @@ template <class T> Cap<T> pivot_transform_cap(const Cap<T>& c, const Vec3<T>& rp
   // distance formula instead, sin(psi'') = k sin(alpha) / (|p1 - r_p| |p2 - r_p|), without cancellation.
   const T chord_denominator = d1 * d2;
   const T s = chord_denominator > T(0) ? k * sin_a / chord_denominator : T(1);
-  T image_omc;
-  if (s < T(0.5)) {
-    const T small = s * s / (T(1) + std::sqrt((T(1) - s) * (T(1) + s)));
-    image_omc = axis.dot(g1) >= T(0) ? small : T(2) - small;
-    if (axis_minus_pivot && image_omc == small && sum.squaredNorm() >= diff.squaredNorm() && d1 > T(0) && d2 > T(0)) {
-      const Vec3<T> q1 = (k / (d1 * d1)) * o1, q2 = (k / (d2 * d2)) * o2;
-      const Vec3<T> h = (q1 + q2) / T(2), m = rp + h;
-      const T mn = m.norm();
-      const Vec3<T> off = h + m * ((q1 - q2).squaredNorm() / T(4) / (T(1) + mn) / mn);
-      const Vec3<T> a = rp + off;
-      if (all_finite(off) && a.norm() > T(0)) {
-        *axis_minus_pivot = off;
-        axis = a / a.norm();
-        if (relative) *relative = true;
-      }
-    }
-  } else {
-    image_omc = std::min(T(2), ((g1 - axis).squaredNorm() + (g2 - axis).squaredNorm()) / T(4));
+  if (!(s < T(0.5)))
+    return Cap<T>{axis, std::min(T(2), ((g1 - axis).squaredNorm() + (g2 - axis).squaredNorm()) / T(4))};
+  const T small = s * s / (T(1) + std::sqrt((T(1) - s) * (T(1) + s)));
+  const T image_omc = axis.dot(g1) >= T(0) ? small : T(2) - small;
+  Vec3<T> off = Vec3<T>::Zero();
+  if (axis_minus_pivot && image_omc == small && sum.squaredNorm() >= diff.squaredNorm() && d1 > T(0) && d2 > T(0) &&
+      sptd_detail::image_axis_offset(rp, k, o1, o2, d1, d2, off)) {
+    *axis_minus_pivot = off;
+    const Vec3<T> a = rp + off;
+    axis = a / a.norm();
+    if (relative) *relative = true;
   }
   return Cap<T>{axis, image_omc};
 }
@@ -380,70 +393,81 @@ template <class T> Vec3<T> sample_uniform_cap_direction(const Cap<T>& c, const V
   return w / w.norm();
 }
 
-// Clamped cosine over a cap: a point of R (header comment) lifted to the hemisphere of n.
+namespace sptd_detail {
+
+// R's chord at the abscissa x found for u0: c and m the disk's and E's half-heights at x, w = c - m (R's half-chord in
+// the crescent); upper_tail when x lies right of x_full, where R's chord is the disk's.
+template <class T> struct CosineCapChord {
+  T x, c, m, w;
+  bool upper_tail;
+};
+
+// x from R's area-CDF (TOMS 748: monotone and continuous). Right of x_full (x0, or E's right end for the crescent; a
+// kink) from the upper tail disk_right_of(x) = (1 - u0) area, solved for theta = acos(x), so that c = sin(theta)
+// keeps its relative precision as u0 -> 1; in the crescent with a tip for s = x - x0, to s's own relative precision.
+template <class T> CosineCapChord<T> invert_cosine_cap_cdf(const CosineCapView<T>& v, T u0) {
+  const T target = u0 * v.area;
+  T lo = T(-1), hi = T(1);
+  if (v.cos_t >= T(0))
+    lo = std::max(lo, v.xc - v.A);
+  else
+    lo = std::max(lo, std::min(v.x0, T(1)));
+  const T upper = (T(1) - u0) * v.area;
+  const T x_full = v.cos_t >= T(0) ? v.x0 : v.xc + v.A;
+  const T seg_full = v.cos_t >= T(0) ? v.seg0 : CosineCapView<T>::disk_right_of(x_full);
+  const bool upper_tail = x_full < T(1) && upper <= seg_full;
+  if (upper_tail) lo = T(0), hi = std::acos(std::max(T(-1), x_full));
+  const bool by_s = v.tip && !upper_tail;
+  if (by_s) lo = T(0), hi = std::max(T(0), std::min(x_full, T(1)) - v.x0);
+  // The unknown q is theta in the upper tail, s = x - x0 in the crescent with a tip, and x otherwise.
+  auto f = [&](T q) {
+    return upper_tail ? CosineCapView<T>::disk_right_of_angle(q) - upper
+           : by_s     ? v.crescent_cdf(q) - target
+                      : v.cdf(q) - target;
+  };
+  T q;
+  const T flo = f(lo), fhi = f(hi);
+  if (flo >= T(0))
+    q = lo;
+  else if (fhi <= T(0))
+    q = hi;
+  else {
+    std::uintmax_t iters = 200;
+    const auto tol = boost::math::tools::eps_tolerance<T>(std::numeric_limits<T>::digits - 2);
+    const auto r = boost::math::tools::toms748_solve(f, lo, hi, flo, fhi, tol, iters);
+    q = (r.first + r.second) / T(2);
+  }
+  if (upper_tail) return {std::cos(q), std::sin(q), T(0), std::sin(q), true};
+  if (by_s) {
+    const auto ch = v.crescent_chord(q);
+    return {v.x0 + q, ch.c, ch.m, ch.w, false};
+  }
+  const T c = std::sqrt(std::max(T(0), (T(1) - q) * (T(1) + q)));
+  const T m = std::min(c, v.ellipse_half_height(q));
+  return {q, c, m, c - m, false};
+}
+
+}  // namespace sptd_detail
+
+// Clamped cosine over a cap: a point of R (header comment) lifted to the hemisphere of n. Where R = E, the uniform
+// disk (polar map) under the affine map onto E; otherwise x from R's area-CDF and y uniform on R's chord at x.
 template <class T> Vec3<T> sample_cosine_cap_direction(const CosineCapView<T>& v, const Vec2<T>& u) {
   T x, y, z;
   if (v.ellipse_only) {
-    // Uniform in E: the uniform disk (polar map) under the affine map onto E.
     const T r = std::sqrt(u[0]), phi = kTwoPi<T> * u[1];
     x = v.xc + v.A * r * std::cos(phi);
     y = v.sin_a * r * std::sin(phi);
     z = std::sqrt(std::max(T(0), (T(1) - x) * (T(1) + x) - y * y));
   } else {
-    // x from R's area-CDF (TOMS 748: monotone and continuous), then y uniform on R's chord at x.
-    const T target = u[0] * v.area;
-    T lo = T(-1), hi = T(1);
-    if (v.cos_t >= T(0))
-      lo = std::max(lo, v.xc - v.A);
-    else
-      lo = std::max(lo, std::min(v.x0, T(1)));
-    // Right of x_full (x0, or E's right end for the crescent; a kink) R is the disk's chord: x from the upper tail
-    // disk_right_of(x) = (1 - u0) area, which keeps its relative precision as u0 -> 1.
-    const T upper = (T(1) - u[0]) * v.area;
-    const T x_full = v.cos_t >= T(0) ? v.x0 : v.xc + v.A;
-    const T seg_full = v.cos_t >= T(0) ? v.seg0 : CosineCapView<T>::disk_right_of(x_full);
-    // Solved for theta = acos(x), so that c = sin(theta) keeps its relative precision near x = 1.
-    const bool upper_tail = x_full < T(1) && upper <= seg_full;
-    if (upper_tail) lo = T(0), hi = std::acos(std::max(T(-1), x_full));
-    // The crescent with a tip, left of x_full: solved for s = x - x0, to s's own relative precision.
-    const bool by_s = v.tip && !upper_tail;
-    if (by_s) lo = T(0), hi = std::max(T(0), std::min(x_full, T(1)) - v.x0);
-    // The unknown q is theta in the upper tail, s = x - x0 in the crescent with a tip, and x otherwise.
-    auto f = [&](T q) {
-      return upper_tail ? CosineCapView<T>::disk_right_of_angle(q) - upper
-             : by_s     ? v.crescent_cdf(q) - target
-                        : v.cdf(q) - target;
-    };
-    T q;
-    const T flo = f(lo), fhi = f(hi);
-    if (flo >= T(0))
-      q = lo;
-    else if (fhi <= T(0))
-      q = hi;
-    else {
-      std::uintmax_t iters = 200;
-      const auto tol = boost::math::tools::eps_tolerance<T>(std::numeric_limits<T>::digits - 2);
-      const auto r = boost::math::tools::toms748_solve(f, lo, hi, flo, fhi, tol, iters);
-      q = (r.first + r.second) / T(2);
-    }
-    T c, m, w;  // the disk's and E's half-heights at x, and w = c - m (R's half-chord in the crescent)
-    if (upper_tail) {
-      x = std::cos(q), c = std::sin(q), m = T(0), w = c;  // right of x_full: R's chord is the disk's
-    } else if (by_s) {
-      const auto ch = v.crescent_chord(q);
-      x = v.x0 + q, c = ch.c, m = ch.m, w = ch.w;
-    } else {
-      x = q;
-      c = std::sqrt(std::max(T(0), (T(1) - x) * (T(1) + x)));
-      m = std::min(c, v.ellipse_half_height(x));
-      w = c - m;
-    }
+    const sptd_detail::CosineCapChord<T> ch = sptd_detail::invert_cosine_cap_cdf(v, u[0]);
+    const T c = ch.c, m = ch.m, w = ch.w;
+    x = ch.x;
     const T s = T(2) * u[1] - T(1);  // in [-1, 1)
     // The lift z = sqrt((c - |y|)(c + |y|)) with c - |y| from 1 - |s| (exact from u1), branching by the inversion's
     // piece: no difference of nearly equal squares.
     const T one_minus_abs_s = T(2) * std::min(u[1], T(1) - u[1]);
     T c_minus_abs_y;
-    if (upper_tail || (v.cos_t >= T(0) && x >= v.x0))
+    if (ch.upper_tail || (v.cos_t >= T(0) && x >= v.x0))
       y = s * c, c_minus_abs_y = c * one_minus_abs_s;
     else if (v.cos_t >= T(0))
       y = s * m, c_minus_abs_y = w + m * one_minus_abs_s;
