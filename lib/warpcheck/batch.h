@@ -1,13 +1,8 @@
 // warpcheck/batch.h: many samples of one light at once, written so that the compiler vectorises the loop.
 //
-// The caller builds the per-light view once (Peters & Dachsbacher 2019 Sec. 3.7); sample_*_batch maps n primary
-// samples to n directions stored as a structure of arrays (x, y, z, pdf), one sample per SIMD lane. The view
-// decides for the whole batch whether samples exist; on "no sample" every output is zero.
-//
-// Sine and cosine are hand-rolled: libm's are calls, vectorised by glibc's libmvec only under -ffast-math, which
-// this project forbids. The quadrant reduction is exact (reduced in u1, not in phi = 2 pi u1) and |a| <= pi/4 is
-// covered by Taylor polynomials truncated below half an ulp of T. The batch therefore agrees with the scalar kernel
-// to a few ulps, not bit for bit (validation/tests/test_batch.cpp).
+// sample_*_batch maps n primary samples to n directions of one light's view, stored as a structure of arrays, one
+// sample per SIMD lane. Sine and cosine are Taylor polynomials after an exact quadrant reduction (libm's vectorise
+// only under -ffast-math, which this project forbids), so the batch agrees with the scalar kernel to a few ulps.
 #pragma once
 
 #include <cstddef>
@@ -95,10 +90,8 @@ template <class T> NoSample sample_sphere_solid_angle_batch(const SphereView<T>&
   const T fx0 = v.frame.x.x(), fx1 = v.frame.x.y(), fx2 = v.frame.x.z();
   const T fy0 = v.frame.y.x(), fy1 = v.frame.y.y(), fy2 = v.frame.y.z();
   const T fz0 = v.frame.z.x(), fz1 = v.frame.z.y(), fz2 = v.frame.z.z();
-  // Blocks of kBlock samples in three loops without calls. Square roots and the clamps of u go through Eigen array
-  // expressions: std::sqrt (errno under -fmath-errno) and ?: (-ftrapping-math) in the loop body stop GCC 12 from
-  // vectorising. The lower clamp is a select on u >= 0, false for NaN, so a NaN u gives 0 (Eigen's max(0) would
-  // propagate it).
+  // Blocks of kBlock samples in three loops without calls; square roots and clamps as Eigen array expressions
+  // (std::sqrt and ?: stop GCC 12 from vectorising). The select on u >= 0 maps a NaN u to 0.
   constexpr std::size_t kBlock = 128;
   using ArrayMap = Eigen::Map<Eigen::Array<T, Eigen::Dynamic, 1>>;
   alignas(64) T ua[kBlock], ub[kBlock], sin_theta[kBlock], cos_theta[kBlock], sin_phi[kBlock], cos_phi[kBlock],

@@ -19,7 +19,7 @@ namespace warpcheck {
 template <class T> using Vec2 = Eigen::Matrix<T, 2, 1>;
 template <class T> using Vec3 = Eigen::Matrix<T, 3, 1>;
 
-// Why a kernel produced no sample. kNone means a sample exists.
+// Why a kernel produced no sample (kNone: a sample exists).
 enum class NoSample : std::uint8_t {
   kNone = 0,
   kNonFinite,        // NaN or Inf anywhere in the input
@@ -82,15 +82,14 @@ template <class T> struct ShadingPoint {
   Vec3<T> normal = Vec3<T>(T(0), T(0), T(1));
 };
 
-// A spherical cap {w : angle(w, axis) <= half_angle}. Stored with the squared chord length 2(1 - cos) so that
-// tiny caps keep their precision: cos(half_angle) rounds to 1 long before the chord does.
+// A spherical cap {w : angle(w, axis) <= half_angle}, stored as 1 - cos (tiny caps keep their precision).
 template <class T> struct Cap {
   Vec3<T> axis = Vec3<T>(T(0), T(0), T(1));
   T one_minus_cos = T(2);  // 1 - cos(half_angle), in [0, 2]
 
   T cos_half_angle() const { return T(1) - one_minus_cos; }
   T solid_angle() const { return T(2) * std::numbers::pi_v<T> * one_minus_cos; }
-  // Inclusion test by chord length: |w - axis|^2 = 2 (1 - w.axis) <= 2 (1 - cos(half_angle)).
+  // By chord length: |w - axis|^2 = 2 (1 - w.axis) <= 2 (1 - cos(half_angle)).
   bool contains(const Vec3<T>& w, T slack = T(0)) const {
     return (w - axis).squaredNorm() <= T(2) * one_minus_cos * (T(1) + slack) + slack;
   }

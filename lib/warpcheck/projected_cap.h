@@ -6,10 +6,9 @@
 // affinely (Alg. 2-3) or by Alg. 4's warp. With h = n.w_d and r_y = r / |d|: Case 1 h >= r_y, Case 2 0 <= h < r_y,
 // Case 3 -r_y < h < 0, Case 4 (no sample) h <= -r_y. pdf is per solid angle (the paper's density times n.w).
 //
-// Beyond the paper (derivations: docs/derivations/projected-cap.md): Alg. 5's argument is the area left of d_x,
-// a in [0, pi]; Alg. 1-4's quantities are taken in forms without cancellation; and the quintic is evaluated at a
-// rescaled argument with each piece ending where it reaches its cut, so the warp is injective, and its density
-// (reported exactly, quintic factor included) tiles the cap. CutDiskInverse::kExact uses the exact inverse instead.
+// Beyond the paper (docs/derivations/projected-cap.md): Alg. 5's argument is the area left of d_x, a in [0, pi];
+// Alg. 1-4's quantities are taken without cancellation; the quintic is rescaled, so the warp is injective, and its
+// exact density is reported. CutDiskInverse::kExact uses the exact inverse instead.
 #pragma once
 
 #include <array>
@@ -252,9 +251,8 @@ template <class T> int unit_scale_geometry(const SphereLightGeometry<T>& g, Sphe
 namespace projected_cap_detail {
 template <class T, CutDiskInverse M> int pieces(const ProjectedCapView<T>& p, std::array<Piece<T>, 2>& out);
 
-// Alg. 1's local frame: z = n, x the horizontal part of w_d as n x (w_d x n), orthogonal to n to rounding even for a
-// light overhead (unlike Gram-Schmidt); replaced only when exactly 0 (a threshold would differ between float and long
-// double). Sets z, x, y, h = n.w_d and w_dx, the horizontal part's length.
+// Alg. 1's frame: z = n, x from w_d's horizontal part n x (w_d x n), horizontal to rounding even for a light overhead
+// (replaced only when exactly 0: a threshold would differ between precisions); h = n.w_d, w_dx its length.
 template <class T> void local_frame(ProjectedCapView<T>& p) {
   const SphereView<T>& s = p.sphere;
   const Vec3<T> wd = s.frame.z;
@@ -284,14 +282,12 @@ template <class T> void case1_geometry(ProjectedCapView<T>& p) {
   p.tau = T(1);
 }
 
-// Case 2 (Alg. 2): the ellipse piece up to X_t and the mirrored disk piece; chord2 = r_y^2 - h^2 > 0.
-// A_E' = pi/2 + A(X_t) = pi - C(theta_E), X_t = cos(theta_E) = v h / (r_y w_dx).
+// Case 2 (Alg. 2), chord2 = r_y^2 - h^2 > 0: A_E' = pi - C(theta_E), X_t = cos(theta_E) = v h / (r_y w_dx).
 template <class T> void case2_geometry(ProjectedCapView<T>& p, T chord2) {
   const T h = p.h, ry = p.r_y, v = p.v;
   p.which_case = 2;
   p.right_e_unit = cut_disk_area_from_angle(std::atan2(std::sqrt(chord2), v * h));
   p.area_e_unit = kPi<T> - p.right_e_unit;
-  // X_t and its half-height sqrt(1 - X_t^2).
   const CutDiskPreimage<T> qe =
       cut_disk_preimage<T, CutDiskInverse::kQuintic>(v * h / (ry * p.w_dx), std::sqrt(chord2) / (ry * p.w_dx));
   p.quintic_area_e_unit = qe.left_area;
@@ -320,7 +316,7 @@ template <class T> void case3_geometry(ProjectedCapView<T>& p, T chord2) {
 }
 }  // namespace projected_cap_detail
 
-// ComputeGeometry (Alg. 1) and the case's pieces (Alg. 2-4), once per light.
+// ComputeGeometry (Alg. 1) and the pieces (Alg. 2-4), once per light.
 template <class T> ProjectedCapView<T> make_projected_cap_view(const SphereLightGeometry<T>& g) {
   using namespace projected_cap_detail;
   ProjectedCapView<T> p;

@@ -79,8 +79,8 @@ template <class T> T pivot_jacobian(const Vec3<T>& w, const Vec3<T>& rp) { retur
 
 namespace sptd_detail {
 
-// Fig. 3 (1): the unit direction t in the plane through the origin, w_c and r_p, orthogonal to w_c, by two
-// Gram-Schmidt passes; any such t where it is rounding noise (every plane through w_c is then one of symmetry).
+// Fig. 3 (1): the unit t orthogonal to w_c in the plane of w_c and r_p, by two Gram-Schmidt passes; any such t where
+// it is rounding noise (every plane through w_c is then one of symmetry).
 template <class T> Vec3<T> boundary_plane_direction(const Vec3<T>& wc, const Vec3<T>& rp) {
   Vec3<T> t = rp - rp.dot(wc) * wc;
   t -= t.dot(wc) * wc;
@@ -90,9 +90,8 @@ template <class T> Vec3<T> boundary_plane_direction(const Vec3<T>& wc, const Vec
                                                                                     : Frame<T>::from_z(wc).x;
 }
 
-// The image axis minus r_p from the boundary points' offsets o_i = r_p - p_i (|o_i| = d_i): q_i = g_i - r_p =
-// k o_i / d_i^2, h = (q1 + q2) / 2, m = r_p + h, and axis - r_p = h + m (1 - |m|) / |m| with 1 - |m|^2 =
-// |q1 - q2|^2 / 4 (docs/derivations/sptd.md). False where it is not representable.
+// The image axis minus r_p from o_i = r_p - p_i: q_i = k o_i / d_i^2, h = (q1 + q2) / 2, m = r_p + h, axis - r_p =
+// h + m (1 - |m|) / |m|, 1 - |m|^2 = |q1 - q2|^2 / 4 (docs/derivations/sptd.md). False if not representable.
 template <class T>
 bool image_axis_offset(const Vec3<T>& rp, T k, const Vec3<T>& o1, const Vec3<T>& o2, T d1, T d2, Vec3<T>& off) {
   const Vec3<T> q1 = (k / (d1 * d1)) * o1, q2 = (k / (d2 * d2)) * o2;
@@ -192,8 +191,7 @@ template <class T> struct CosineCapView {
   T xc = 0, A = 0, x0 = 0;    // ellipse centre and x semi-axis; x >= x0: full chord side
   T seg0 = 0;                 // area of the unit disk right of x0, without cancellation (make_cosine_cap_view)
   bool ellipse_only = false;  // R = E (cap entirely above the horizon)
-  // The crescent's tip at x0 in (-1, 1) (cos t < 0), where E touches the unit circle at (x0, +-c0), and E's
-  // normalised coordinates there, tau0 = (x0 - x_c) / A and n0 = sqrt(1 - tau0^2).
+  // The crescent's tip (x0, +-c0), x0 in (-1, 1), and E's normalised coordinates there, tau0 and n0.
   bool tip = false;
   T c0 = 0, tau0 = 0, n0 = 0;
   T area = 0;  // projected solid angle of (cap, upper hemisphere) = area of R
@@ -395,16 +393,14 @@ template <class T> Vec3<T> sample_uniform_cap_direction(const Cap<T>& c, const V
 
 namespace sptd_detail {
 
-// R's chord at the abscissa x found for u0: c and m the disk's and E's half-heights at x, w = c - m (R's half-chord in
-// the crescent); upper_tail when x lies right of x_full, where R's chord is the disk's.
+// R's chord at x: the disk's and E's half-heights c, m, and w = c - m; upper_tail: right of x_full (the disk's chord).
 template <class T> struct CosineCapChord {
   T x, c, m, w;
   bool upper_tail;
 };
 
-// x from R's area-CDF (TOMS 748: monotone and continuous). Right of x_full (x0, or E's right end for the crescent; a
-// kink) from the upper tail disk_right_of(x) = (1 - u0) area, solved for theta = acos(x), so that c = sin(theta)
-// keeps its relative precision as u0 -> 1; in the crescent with a tip for s = x - x0, to s's own relative precision.
+// x from R's area-CDF (TOMS 748). Right of x_full (a kink) from the upper tail (1 - u0) area, solved for
+// theta = acos(x) so that c = sin(theta) keeps its precision; in the crescent with a tip for s = x - x0.
 template <class T> CosineCapChord<T> invert_cosine_cap_cdf(const CosineCapView<T>& v, T u0) {
   const T target = u0 * v.area;
   T lo = T(-1), hi = T(1);
