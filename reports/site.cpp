@@ -499,7 +499,7 @@ std::string worst_case_section(const fs::path& data) {
   if (files.empty())
     return o.str() + not_run("no recorded worst case in data/worst-cases/",
                              "warpcheck worst-case --search NAME --seconds 600 --json data/worst-cases/NAME.json "
-                             "(see validation/README-worst-case.md)");
+                             "(see docs/worst-case.md)");
   o << "<table><tr><th>search</th><th>worst error found</th><th>paper</th><th>evaluations</th><th>seconds</th>"
        "<th>kernel version</th><th>command</th></tr>";
   std::ostringstream plots;

@@ -2,7 +2,7 @@
 # Re-records data/worst-cases/<search>.json for every search (or the searches named as arguments):
 #   data/worst-cases/record.sh BUILD_DIR [SECONDS] [SEARCH...]
 # One thread, seed 1, SECONDS (default 10) per search. polygon-backward-k2 was recorded separately by the
-# long runs (see validation/README-worst-case.md); this script skips it unless it is named.
+# long runs (see docs/worst-case.md); this script skips it unless it is named.
 # A short search can find less than the record it replaces (the old input came from a longer or luckier run),
 # so when a record exists its input is re-evaluated with the current kernels (warpcheck worst-case --evaluate
 # OLD --json) and the worse of the two is kept: the old input with its new error, or the new search's.

@@ -1,9 +1,8 @@
 // warpcheck/core.h: the types every kernel shares.
 //
-// Every kernel in lib/ is templated on its scalar type T (float, double, long double) so the same code can be
-// checked against its own long double instantiation. Every kernel returns a DirectionSample<T>: a unit
-// world-space direction, its density with respect to solid angle, and whether a sample exists at all. A kernel
-// never returns NaN and never throws for bad geometry: it returns "no sample" with a NoSample reason instead.
+// Every kernel is templated on its scalar type T (float, double, long double), so that it can be checked against
+// its own long double instantiation, and returns a DirectionSample<T>: a unit direction, its density per solid
+// angle, or "no sample" with a reason. A kernel never returns NaN and never throws for bad geometry.
 #pragma once
 
 #include <bit>
@@ -20,7 +19,7 @@ namespace warpcheck {
 template <class T> using Vec2 = Eigen::Matrix<T, 2, 1>;
 template <class T> using Vec3 = Eigen::Matrix<T, 3, 1>;
 
-// Why a kernel produced no sample. kNone means a sample exists.
+// Why a kernel produced no sample (kNone: a sample exists).
 enum class NoSample : std::uint8_t {
   kNone = 0,
   kNonFinite,        // NaN or Inf anywhere in the input
@@ -83,15 +82,14 @@ template <class T> struct ShadingPoint {
   Vec3<T> normal = Vec3<T>(T(0), T(0), T(1));
 };
 
-// A spherical cap {w : angle(w, axis) <= half_angle}. Stored with the squared chord length 2(1 - cos) so that
-// tiny caps keep their precision: cos(half_angle) rounds to 1 long before the chord does.
+// A spherical cap {w : angle(w, axis) <= half_angle}, stored as 1 - cos (tiny caps keep their precision).
 template <class T> struct Cap {
   Vec3<T> axis = Vec3<T>(T(0), T(0), T(1));
   T one_minus_cos = T(2);  // 1 - cos(half_angle), in [0, 2]
 
   T cos_half_angle() const { return T(1) - one_minus_cos; }
   T solid_angle() const { return T(2) * std::numbers::pi_v<T> * one_minus_cos; }
-  // Inclusion test by chord length: |w - axis|^2 = 2 (1 - w.axis) <= 2 (1 - cos(half_angle)).
+  // By chord length: |w - axis|^2 = 2 (1 - w.axis) <= 2 (1 - cos(half_angle)).
   bool contains(const Vec3<T>& w, T slack = T(0)) const {
     return (w - axis).squaredNorm() <= T(2) * one_minus_cos * (T(1) + slack) + slack;
   }
@@ -120,14 +118,10 @@ template <class T> struct Frame {
   Vec3<T> to_local(const Vec3<T>& v) const { return Vec3<T>(v.dot(x), v.dot(y), v.dot(z)); }
 };
 
-// Cube root for per-sample paths. Hand-rolled because glibc's cbrtf / cbrt cost 14 / 16 ns on our machines
-// (measured with a Google Benchmark loop; with its scalbnf / frexpf helpers 23% of a float projected-cap sample
-// under perf) and cannot be inlined. fdlibm's exponent-third guess (within ~3%; Kahan's constants) and Halley's
-// iteration y <- y + y (x - y^3) / (2 y^3 + x), cubic convergence: 3e-5, 3e-14, then rounding. Float iterates
-// in double (two steps) and is rounded once; double takes three steps. Error against cbrtl: see the test
-// CubeRoot.IsWithinHalfAnUlpInFloatAndOneUlpInDouble (measured there: float 0.50 ulp, double 0.95 ulp;
-// glibc: cbrtf 0.95, cbrt 3.4). Outside
-// [2^-600, 2^600] (where y^3 could underflow), for long double and for 0, negatives, Inf, NaN: std::cbrt.
+// Cube root for per-sample paths, inlinable (glibc's cbrt is a call): fdlibm's exponent-third guess (within ~3%),
+// then Halley's iteration y <- y + y (x - y^3) / (2 y^3 + x): 3e-5, 3e-14, then rounding. Float takes two steps in
+// double, double three (error: test CubeRoot.*). Outside [2^-600, 2^600] (y^3 could underflow), for long double
+// and for 0, negatives, Inf, NaN: std::cbrt.
 template <class T> T cube_root(T x) {
   if constexpr (std::is_same_v<T, float> || std::is_same_v<T, double>) {
     const double xd = double(x);
@@ -144,17 +138,10 @@ template <class T> T cube_root(T x) {
   return std::cbrt(x);
 }
 
-// x^(2/3) of a float without a division: the per-sample root of the float projected-cap quintic (projected_cap.h),
-// issue 9. Hand-rolled instead of cube_root(x * x) above because that one's two Halley steps divide in double and
-// lie on the sample's critical path (the float Case-1 sample in a scratch benchmark: 43.6 ns with two division-free
-// steps of the series below, about as fast as cube_root; 37.7 ns with the one step below; 35.2 ns with the root
-// replaced by a no-op, for timing only). In double: the inverse root r = x^(-1/3) from an exponent-third guess, the
-// bits of r0 = K - bits(x) / 3 (K fitted by us to minimise the guess's largest relative error over [1, 8): 3.42%),
-// then one division-free step r <- r (1 + d P(d)), d = 1 - x r^3, with P the series of (1 - d)^(-1/3) = 1 + d/3 +
-// 2 d^2/9 + ... to d^7 (coefficients c_k = c_{k-1} (3k - 2) / (3k)); |d| <= 0.106, so the first omitted term is
-// below 1.6e-9 relative. x^(2/3) = x r = x r0 + x r0 d P(d), rounded once to float. Every step scales exactly with
-// x -> 8 x, so [1, 8) covers every float whose result is normal; measured error against cbrtl over every float in
-// [1, 8): test CubeRootSquaredForFloat.IsWithinAnUlpOverEveryFloatOfOnePeriodAndScalesExactlyByEight (0.5228 ulp).
+// x^(2/3) of a float without a division (the float projected-cap quintic's root). In double: r = x^(-1/3) from an
+// exponent-third guess (K fitted: at most 3.42% off over [1, 8)), then one division-free step r <- r (1 + d P(d)),
+// d = 1 - x r^3, P the series of (1 - d)^(-1/3) to d^7; |d| <= 0.106 leaves below 1.6e-9. x^(2/3) = x r, rounded
+// once. Exact under x -> 8 x, so [1, 8) covers every float (exhaustive test: CubeRootSquaredForFloat.*).
 // x = 0 gives 0; negative, Inf, NaN: std::cbrt.
 inline float cube_root_squared_for_float(float x) {
   if (!(x > 0.0f) || !(x <= std::numeric_limits<float>::max())) {
@@ -178,17 +165,11 @@ template <class T> Vec3<T> ldexp(const Vec3<T>& v, int e) {
 }
 
 // Renormalises a direction that is a unit vector up to rounding (a sampler's output): one division and three
-// products instead of Eigen's normalized(), which divides each component (three divisions; measured 3 of the
-// top 4 instructions of the float projected-cap sample under perf). Not for vectors that may be 0 or huge.
+// products instead of normalized()'s three divisions. Not for vectors that may be 0 or huge.
 template <class T> Vec3<T> renormalized(const Vec3<T>& v) { return v * (T(1) / v.norm()); }
 
-// The factor that renormalises a vector v of squared length n2 = |v|^2 near 1 (a sampler's direction, unit up to a
-// few roundings) without a square root or division: one Newton step of 1 / sqrt at 1, (3 - n2) / 2, whose relative
-// error is 3/8 (n2 - 1)^2 (below 2.2e-8 for |n2 - 1| <= 2^-12; measured over every float there: test
-// NearUnitRenormalization.*, 0.69 ulp); farther from 1 (not expected of a sampler), 1 / sqrt(n2). A caller may pass
-// n2 before v is complete (a rotation preserves it up to rounding). Issue 9: renormalized's square root and division
-// ended the float projected-cap sample's dependency chain (its divss took 12% of the samples in the function under
-// perf, float, q_z = -0.1).
+// The factor that renormalises a vector of squared length n2 near 1 without a square root or division: one Newton
+// step of 1 / sqrt at 1, (3 - n2) / 2, error 3/8 (n2 - 1)^2 (< 2.2e-8 for |n2 - 1| <= 2^-12); else 1 / sqrt(n2).
 template <class T> T near_unit_renormalization_factor(T n2) {
   if (!(std::abs(n2 - T(1)) <= T(0x1p-12))) return T(1) / std::sqrt(n2);
   return (T(3) - n2) * T(0.5);

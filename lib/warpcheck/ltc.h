@@ -1,15 +1,10 @@
 // warpcheck/ltc.h: sampling a polygon light proportionally to a linearly transformed cosine (LTC),
 // Peters 2021 Section 4.1 (LTCs from Heitz, Dupuy, Hill & Neubelt 2016).
 //
-// For M in R^{3x3} with |M| > 0, given in the shading frame (z = the shading normal), the LTC is
-//   p_M(w) = (1/pi) max(0, (M^-1 w)_z / |M^-1 w|) |M^-1| / |M^-1 w|^3.
-// Sampling (Sec. 4.1): transform the polygon's vertices by M^-1, clip to z >= 0, sample the transformed
-// polygon by projected solid angle (polygon_projected.h, Peters 2021 Sec. 3), transform the direction back by
-// M and normalise. The samples fall into the polygon P, distributed proportionally to p_M; the density is
-// normalised by Eq. 10, int_P p_M = A_Sigma(M^-1 P) / pi, the projected solid angle the sampler computes anyway:
-//   pdf(w) = p_M(w) pi / A_Sigma = pdf_projected(M^-1 w / |M^-1 w|) |M^-1| / |M^-1 w|^3.
-// Like the paper's implementation we clip only against the horizon of the transformed space: samples may lie
-// below the shading horizon (where a BRDF is zero; the caller's integrand handles that).
+// For M with |M| > 0, in the shading frame: p_M(w) = (1/pi) max(0, (M^-1 w)_z / |M^-1 w|) |M^-1| / |M^-1 w|^3.
+// Sampling (Sec. 4.1): sample M^-1 P by projected solid angle (polygon_projected.h), map back by M and normalise;
+// by Eq. 10, int_P p_M = A_Sigma(M^-1 P) / pi, so pdf(w) = pdf_projected(M^-1 w / |M^-1 w|) |M^-1| / |M^-1 w|^3.
+// As in the paper, only the transformed horizon clips: samples may lie below the shading horizon.
 #pragma once
 
 #include <Eigen/LU>
@@ -27,15 +22,8 @@ template <class T> struct LtcPolygonGeometry {
   template <class U> LtcPolygonGeometry<U> cast() const { return {polygon.template cast<U>(), m.template cast<U>()}; }
 };
 
-// M^-1 and |M| for |M| > 0, from Gaussian elimination with full pivoting (Eigen's FullPivLU): false for a singular
-// or reflecting M and for one whose inverse or 1 / |M| overflows. Not the cofactor formula of Eigen's inverse() /
-// computeInverseAndDetWithCheck for 3x3: it is not backward stable, and for an ill-conditioned M its inverse is
-// a right inverse only (found by fuzz_ltc_double f84856d2: cond(M) 6e10, |M X - I| 1.6e-58 but |X M - I| 2.2, so
-// the sample's pdf from M c and pdf(direction) from X w, 0.83 % apart; issue 7). LU with pivoting gives an X
-// with X = (M + dM)^-1, |dM| ~ eps |M|, both residuals ~ eps cond(M) (1.8e-62 and 4e-62 there). The
-// determinant is the pivots' product, tested before inverse() divides by the pivots: a zero pivot makes it 0.
-// (An earlier cofactor determinant() was 1.4e-17 where inverse()'s own expansion was 0: a division by zero under
-// UBSan, fuzz_ltc_double d6818c25; issue 7.)
+// M^-1 and |M| > 0 by LU with full pivoting (false for a singular, reflecting or overflowing M): X = (M + dM)^-1 with
+// |dM| ~ eps |M|, both residuals ~eps cond(M), unlike the cofactor inverse. The pivots' product is tested first.
 template <class T> bool ltc_inverse(const Mat3<T>& m, Mat3<T>* m_inv, T* det) {
   if (!m.allFinite()) return false;
   const Eigen::FullPivLU<Mat3<T>> lu(m);
@@ -59,11 +47,8 @@ template <class T> struct LtcPolygonView {
   Mat3<T> m = Mat3<T>::Identity(), m_inv = Mat3<T>::Identity();
   T det = T(1), det_inv = T(1);
   PolygonProjectedView<T> transformed;  // M^-1 P, seen from the origin with normal z, clipped to z >= 0
-  // pdf()'s test "w in P", in world space (polygon_inward_planes): M^-1 w is in the cone of M^-1 P iff w is in P's,
-  // but the transformed cone's planes come from rounded vertices M^-1 (V - x), whose differences lose a short
-  // edge's direction (found by fuzz_ltc_double, 834135fe: vertices 3e51 apart at 2e67 were both snapped onto the
-  // horizon, the edge's plane became the horizon with an orientation of rounding noise, pdf 0 at samples 0.09
-  // rad inside; issue 7). The world edges V_{j+1} - V_j are exact.
+  // pdf()'s test "w in P", by P's own planes in world space (polygon_inward_planes): equivalent to M^-1 w in the
+  // cone of M^-1 P, but from exact world edges V_{j+1} - V_j instead of rounded transformed vertices.
   std::array<Vec3<T>, kMaxPolygonVertices> inward{};
   int planes = 0;
   T integral = 0;  // int_P p_M = A_Sigma(M^-1 P) / pi (Eq. 10)
@@ -86,11 +71,8 @@ template <class T> PolygonLightGeometry<T> ltc_transformed_polygon(const Polygon
   return tg;
 }
 
-// The rounding of M^-1 P's computed vertices relative to |M^-1 v|_inf, the vertex_rounding of check_polygon and
-// make_polygon_view for the transformed polygon. M^-1 P is convex, but its vertices carry the rounding of the frame
-// change (a few eps |v|) and of the product: 3 eps |M^-1|_F |v|_2 <= 3 eps cond_F(M) |M^-1 v|_2 <= 3 sqrt(3) eps
-// cond_F(M) |M^-1 v|_inf. check_polygon forgives reflex turns up to that rounding (and no further: polygon.h), and
-// make_polygon_view flattens the polygon where that rounding leaves it non-planar.
+// The rounding of M^-1 P's vertices relative to |M^-1 v|_inf (check_polygon's vertex_rounding): the frame change's
+// and the product's, 3 eps |M^-1|_F |v|_2 <= 3 sqrt(3) eps cond_F(M) |M^-1 v|_inf.
 template <class T> T ltc_vertex_rounding(const Mat3<T>& m, const Mat3<T>& m_inv) {
   const T eps = std::numeric_limits<T>::epsilon();
   return kPolygonVertexRounding<T> + T(3) * std::sqrt(T(3)) * eps * (m.norm() * m_inv.norm());
@@ -113,12 +95,8 @@ template <class T> LtcPolygonView<T> make_ltc_polygon_view(const LtcPolygonGeome
   return v;
 }
 
-// pdf(w) = pdf_projected(c) |M c|^3 / |M| at c = M^-1 w / |M^-1 w| (the sampler's Jacobian, with |M^-1 w| = 1 / |M c|).
-// |M c| from M itself, not 1 / |Minv_T w|: the computed inverse is Minv_T = M^-1 (I + E) with |E| up to eps cond(M),
-// so Minv_T w = M^-1 w' for a w' = (I + E) w that is turned by up to |E| (harmless: the density is smooth) and
-// stretched by up to |E|, which 1 / |Minv_T w|^3 turns into a relative error of 3 |E| of the density (found by
-// fuzz_ltc_double, b98e6f95: cond(M) 1024, |E| 8.9e-14, sample pdf and pdf(direction) 8.3e-14 apart = 3 (E w).w;
-// issue 7). c depends only on the direction of w', and |M c| = |w'| / |Minv_T w|: the density at w' / |w'| exactly.
+// pdf(w) = pdf_projected(c) |M c|^3 / |M| at c = M^-1 w / |M^-1 w|. |M c| from M, not 1 / |M^-1 w|: the computed
+// inverse's error (eps cond(M)) would stretch w and enter cubed, whereas c's direction is off harmlessly.
 template <class T> T pdf_ltc_polygon(const LtcPolygonView<T>& v, const Vec3<T>& w) {
   if (!v.valid() || !all_finite(w)) return T(0);
   const T len = w.norm();
@@ -136,9 +114,8 @@ template <class T> T pdf_ltc_polygon(const LtcPolygonView<T>& v, const Vec3<T>& 
 }
 
 // Tangent-line iterations of the decentral sector inversion (Peters 2021 Sec. 3.3; the paper's default is 2).
-// M^-1 P is often a thin, strongly decentral polygon, where 2 iterations leave the warp's true density off its
-// reported pdf: `warpcheck validate --kernel polygon-ltc --config lobe-away --scalar double --samples 1000000`
-// measured pdf-consistency 1.3e-4 (near xi_0 = 1) with 2 iterations and 5.7e-8 with 4. Correct first: 4.
+// M^-1 P is often thin and strongly decentral, where 2 iterations leave the warp's density measurably off its pdf
+// (docs/measurements.md): 4.
 inline constexpr int kLtcSectorIterations = 4;
 
 template <class T> DirectionSample<T> sample_ltc_polygon(const LtcPolygonView<T>& v, const Vec2<T>& u,

@@ -1,8 +1,8 @@
 // warpcheck/mis.h: multiple importance sampling for a mixed diffuse + specular BRDF lit by a polygon light,
 // Peters 2021 Sections 4.2 (weighted balance heuristic) and 4.3 (clamped optimal MIS).
 //
-// Two techniques (N = 2, as in the paper): j = 0 projected-solid-angle sampling (the LTC with M_0 = I, i.e. the
-// Lambertian lobe) and j = 1 LTC sampling with M_1 (ltc.h). Their normalised densities are p_j (Eq. 12) and
+// Two techniques: j = 0 projected solid angle (the LTC with M_0 = I) and j = 1 the LTC with M_1 (ltc.h), with
+// normalised densities p_j (Eq. 12) and
 //   c_j = L_e a_j int_P p_{M_j}                                  (Sec. 4.2, the unshadowed LTC shading)
 //   w_j^w = c_j p_j / sum_k c_k p_k                              (weighted balance heuristic)
 //   w_j^c = v w_j^w + (1 - v) p_j / sum_k p_k                    (clamped optimal MIS, Sec. 4.3)

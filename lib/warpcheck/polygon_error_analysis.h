@@ -1,13 +1,10 @@
 // warpcheck/polygon_error_analysis.h: the empirical error analysis of Peters 2021 Sec. 3.6 and 6.4, as
 // functions the tests and tools/polygon_claims.cpp share.
 //
-// Backward error (Sec. 3.6): |A_delta| from Eq. 7 divided by the sector's area, i.e. the perturbation of
-// xi_0 (within the sector) that explains the error of the inverted azimuth.
-//
-// Our random decentral test cases (the paper does not state the distribution behind its 99th percentile, so
-// this is ours): a triangle with three vertex directions uniform on the upper hemisphere, kept if it is in
-// the decentral case; one of its sectors uniformly; a target A = xi A_sector with xi uniform. Like the paper's
-// search we discard sectors of more than 179.999 degrees or of area below `min_area` (the paper: 1e-2).
+// Backward error (Sec. 3.6): |A_delta| (Eq. 7) over the sector's area, the perturbation of xi_0 that explains the
+// inverted azimuth's error. Random decentral cases (ours; the paper's distribution is not stated): triangles with
+// vertex directions uniform on the upper hemisphere, a sector uniformly, A = xi A_sector; like the paper, sectors
+// over 179.999 degrees or of area below `min_area` (the paper: 1e-2) are discarded.
 #pragma once
 
 #include <random>

@@ -1,14 +1,8 @@
 // warpcheck/polygon_solid_angle.h: solid-angle sampling of convex polygons, Peters 2021 Section 5 (plain and
-// clipped to the upper hemisphere), and the published baselines for polygons: Arvo 1995 (stratified
-// sampling of spherical triangles, applied to a triangle fan) and Turk 1992 (uniform area sampling, density
-// reported per solid angle).
-//
-// Densities:  solid angle  pdf(w) = 1 / Omega inside the polygon's cone (clipped or not);
-//             Arvo 1995    the same, with Omega = sum of the fan triangles' alpha + beta + gamma - pi;
-//             Turk 1992    pdf(w) = h^2 / (|N.w|^3 Area) where the ray meets the polygon (h: distance of the
-//                          shading point from the light's plane, N: unit normal of the plane).
-// The unclipped kernels sample the whole polygon, also where it lies below the shading horizon (those
-// samples carry a zero cosine for the caller); only a light entirely below it gives "no sample".
+// clipped to the upper hemisphere), and the published baselines Arvo 1995 (spherical triangles, as a fan) and
+// Turk 1992 (uniform area). Densities: 1 / Omega inside the cone (Arvo: Omega from the angle sums); Turk
+// h^2 / (|N.w|^3 Area). The unclipped kernels also sample below the shading horizon.
+// Derivations and the fan's safeguards: docs/derivations/polygon-solid-angle.md.
 #pragma once
 
 #include "warpcheck/polygon.h"
@@ -23,14 +17,8 @@ template <class T> struct PolygonFanView {
   std::array<Vec3<T>, kMaxFanVertices> e{};  // p_k - p_0, from the light's own vertices if unclipped
   std::array<Vec3<T>, kMaxFanVertices> u{};  // p_k / |p_k|
   std::array<T, kMaxFanVertices> len{};      // |p_k| by stableNorm (norm() underflows for |p| < 1e-154)
-  // The cone is {w : inward_j . w >= 0, j < planes}: unclipped, inward_j = p_j x p_{j+1}; clipped, the
-  // light's own edge planes (from V_j - x) and the horizon, never planes through two clip points, whose
-  // normal is undetermined when the clip points (nearly) coincide (found by fuzz_polygon_solid_angle_double:
-  // pdf 0 for a sample 2e-10 rad inside the clipped polygon).
-  // Both also have the plane through x parallel to the light's (its far side): the edge planes all pass through x,
-  // so near a sliver's vertex they hold its antipode too, up to a margin of the sliver's width that rounds to 0
-  // (found by fuzz_polygon_solid_angle_double de04c20e...: a hexagon 8 long and 1.4e-9 wide, pdf 9e18 at the
-  // antipode of a vertex's direction, issue 7).
+  // The cone {w : inward_j . w >= 0}: the light's edge planes, the horizon (clipped), and the plane through x
+  // parallel to the light's (which excludes the antipodes a sliver's edge planes let in).
   std::array<Vec3<T>, kMaxFanVertices> inward{};
   int planes = 0;
   Vec3<T> plane_normal = Vec3<T>::Zero();  // unit
@@ -38,21 +26,132 @@ template <class T> struct PolygonFanView {
   bool valid() const { return reason == NoSample::kNone; }
 };
 
-// u_b - u_a for u = p / |p|, from the edge e = p_b - p_a without cancellation:
-// u_b - u_a = (e |p_a| - p_a (|p_b| - |p_a|)) / (|p_a| |p_b|), |p_b| - |p_a| = e.(p_a + p_b) / (|p_a| + |p_b|).
+// u_b - u_a for u = p / |p|, from the edge e = p_b - p_a without cancellation: (e - u_a (|p_b| - |p_a|)) / |p_b| with
+// |p_b| - |p_a| = e.(p_a + p_b) / (|p_a| + |p_b|), and no product of two lengths (which underflows for tiny p).
 // na = |p_a|, nb = |p_b| (PolygonFanView::len).
 template <class T> Vec3<T> unit_difference(const Vec3<T>& pa, T na, const Vec3<T>& pb, T nb, const Vec3<T>& e) {
-  // Grouped as (e - u_a (|p_b| - |p_a|)) / |p_b| with the dot product taken against (p_a + p_b) / (|p_a| + |p_b|):
-  // no product of two lengths, which underflows for a light ~1e-160 from x (UBSan: division by zero, found by
-  // fuzz_polygon_solid_angle_double 0f46b33f..., issue 7).
   const T dn = e.dot(Vec3<T>((pa + pb) / (na + nb)));
   return (e - (pa / na) * dn) / nb;
 }
 
-// split_wide_edges (Section 5's sampler, make_polygon_solid_angle_view): every edge of the fan wider than 120 degrees
-// gets its midpoint as an extra vertex, and the fan is rooted at the first (see the end of this function).
+namespace polygon_fan_detail {
+
+// The unclipped fan: the (flattened, PolygonView::lift) light's vertices from x, wound positively, vertex 0 first.
+template <class T>
+void unclipped_fan(const PolygonLightGeometry<T>& g, const PolygonView<T>& pv, bool reverse, PolygonFanView<T>& f) {
+  const int m = g.light.count;
+  f.count = m;
+  const Vec3<T>& nh = pv.plane_normal;
+  for (int k = 0; k < m; ++k) {
+    const int src = reverse ? (m - k) % m : k;  // keeps vertex 0 first
+    f.p[k] = g.light.vertices[src] - g.shading.position - pv.lift[src] * nh;
+    f.e[k] = g.light.vertices[src] - g.light.vertices[0] - (pv.lift[src] - pv.lift[0]) * nh;
+  }
+}
+
+// The fan of the light clipped to the upper hemisphere; false when nothing is strictly above the horizon. A horizon
+// edge wider than 90 degrees (at most one) gets its midpoint n x (u_b - u_a) as a vertex and the root: no fan
+// triangle then joins its nearly antipodal ends by a great circle of rounding noise.
+template <class T>
+bool clipped_fan(const PolygonView<T>& pv, bool reverse, PolygonFanView<T>& f, bool& horizon_rooted) {
+  const LocalPolygon<T> c = clip_to_upper_hemisphere(pv.local);
+  bool strictly_above = false;
+  for (int i = 0; i < c.count; ++i) strictly_above = strictly_above || c.v[i].z() > T(0);
+  if (c.count < 3 || !strictly_above) return false;
+  std::array<Vec3<T>, kMaxFanVertices> q;
+  int nq = 0, root = 0;
+  const Vec3<T> light_normal = pv.frame.to_local(pv.plane_normal);
+  for (int i = 0; i < c.count; ++i) {
+    const Vec3<T>&a = c.v[i], &b = c.v[(i + 1) % c.count];
+    q[nq++] = a;
+    if (a.z() != T(0) || b.z() != T(0) || nq + (c.count - 1 - i) >= kMaxFanVertices) continue;  // room for the rest
+    const Vec3<T> ua = safe_normalized(a), ub = safe_normalized(b);
+    if (!(ua.dot(ub) < T(0))) continue;
+    Vec3<T> mid = safe_normalized(Vec3<T>(ua.y() - ub.y(), ub.x() - ua.x(), T(0)));
+    if (light_normal.dot(mid) * pv.plane_distance < T(0)) mid = -mid;
+    if (!mid.isZero()) root = nq, q[nq++] = mid * ((a.norm() + b.norm()) / T(2)), horizon_rooted = true;
+  }
+  f.count = nq;
+  for (int k = 0; k < nq; ++k) f.p[k] = pv.frame.to_world(q[reverse ? (root - k + nq) % nq : (root + k) % nq]);
+  for (int k = 0; k < nq; ++k) f.e[k] = f.p[k] - f.p[0];
+  return true;
+}
+
+// u_k and |p_k| (and e_k = p_k - p_0 if asked) of the fan's vertices; false for a vertex without a direction.
+template <class T> bool fan_directions(PolygonFanView<T>& f, bool edges_from_p0) {
+  for (int k = 0; k < f.count; ++k) {
+    if (edges_from_p0) f.e[k] = f.p[k] - f.p[0];
+    f.u[k] = safe_normalized(f.p[k]);
+    f.len[k] = f.p[k].stableNorm();
+    if (f.u[k].isZero()) return false;
+  }
+  return true;
+}
+
+// The cone's planes: the light's own edge planes (polygon_inward_planes), the horizon if clipped, then the light's
+// plane.
+template <class T> void fan_cone(const PolygonLightGeometry<T>& g, const PolygonView<T>& pv, bool reverse, bool clipped,
+                                 PolygonFanView<T>& f) {
+  const int m = polygon_inward_planes(g, pv, f.inward.data());
+  if (!clipped) {
+    f.inward[m] = reverse ? Vec3<T>(-pv.plane_normal) : pv.plane_normal;
+    f.planes = m + 1;
+  } else {
+    const T orient = reverse ? T(-1) : T(1);
+    f.inward[m] = pv.normal;  // m <= kMaxPolygonVertices = kMaxFanVertices - 2
+    f.inward[m + 1] = orient * pv.plane_normal;
+    f.planes = m + 2;
+  }
+}
+
+// The midpoint of the fan edge from u_k to u_k1 (unit), m x (u_k - u_k1) with m the cone's edge plane that holds both
+// ends best, signed to lie on the short arc and on the light's side of the cone's last plane (by the larger test);
+// zero when there is none.
+template <class T> Vec3<T> wide_edge_midpoint(const PolygonFanView<T>& f, int k, int k1) {
+  int best = -1;
+  T best_residual = std::numeric_limits<T>::infinity();
+  for (int j = 0; j + 1 < f.planes; ++j) {
+    const Vec3<T> mj = safe_normalized(f.inward[j]);
+    const T r = std::max(std::abs(mj.dot(f.u[k])), std::abs(mj.dot(f.u[k1])));
+    if (r < best_residual) best_residual = r, best = j;
+  }
+  if (best < 0) return Vec3<T>::Zero();
+  Vec3<T> mid = safe_normalized(kahan_cross(safe_normalized(f.inward[best]), Vec3<T>(f.u[k] - f.u[k1])));
+  if (mid.isZero()) return mid;
+  const T by_arc = mid.dot(Vec3<T>(f.u[k] + f.u[k1])), by_side = mid.dot(safe_normalized(f.inward[f.planes - 1]));
+  if ((std::abs(by_arc) >= std::abs(by_side) ? by_arc : by_side) < T(0)) mid = -mid;
+  return mid;
+}
+
+// Edges wider than 120 degrees (at most two) get their midpoints as vertices, the fan rooted at the first (unless it
+// is rooted at a horizon midpoint): no fan triangle then has Eq. 13's G1 + G2 as a difference of numbers near 2.
+// False for a vertex without a direction.
+template <class T> bool split_wide_fan_edges(PolygonFanView<T>& f, bool horizon_rooted) {
+  std::array<Vec3<T>, kMaxFanVertices> q;
+  int nq = 0, root = -1;
+  for (int k = 0; k < f.count; ++k) {
+    const int k1 = (k + 1) % f.count;
+    q[nq++] = f.p[k];
+    if (!(f.u[k].dot(f.u[k1]) < T(-0.5)) || nq + (f.count - 1 - k) >= kMaxFanVertices) continue;
+    const Vec3<T> mid = wide_edge_midpoint(f, k, k1);
+    if (mid.isZero()) continue;
+    if (root < 0) root = nq;
+    q[nq++] = mid * ((f.len[k] + f.len[k1]) / T(2));
+  }
+  if (nq == f.count) return true;
+  if (horizon_rooted || root < 0) root = 0;
+  for (int k = 0; k < nq; ++k) f.p[k] = q[(root + k) % nq];
+  f.count = nq;
+  return fan_directions(f, true);
+}
+
+}  // namespace polygon_fan_detail
+
+// The polygon's fan as seen from the shading point, clipped to the upper hemisphere or not. split_wide_edges
+// (Section 5's sampler): fan edges wider than 120 degrees get their midpoints as vertices.
 template <class T>
 PolygonFanView<T> make_polygon_fan_view(const PolygonLightGeometry<T>& g, bool clipped, bool split_wide_edges = false) {
+  using namespace polygon_fan_detail;
   PolygonFanView<T> f;
   const PolygonView<T> pv = make_polygon_view(g);
   if (!pv.valid()) return f.reason = pv.reason, f;
@@ -63,137 +162,13 @@ PolygonFanView<T> make_polygon_fan_view(const PolygonLightGeometry<T>& g, bool c
   if (!above) return f.reason = NoSample::kBelowHorizon, f;
   const bool reverse = pv.plane_distance < T(0);
   bool horizon_rooted = false;  // the clipped fan is rooted at a horizon edge's midpoint
-  if (!clipped) {
-    const int m = g.light.count;
-    f.count = m;
-    // The flattened light's vertices where the light is non-planar (PolygonView::lift; zero lifts otherwise, and
-    // then the same values as V - x and V - V_0), like the clipped fan's and the planes below.
-    const Vec3<T>& nh = pv.plane_normal;
-    for (int k = 0; k < m; ++k) {
-      const int src = reverse ? (m - k) % m : k;  // keeps vertex 0 first
-      f.p[k] = g.light.vertices[src] - g.shading.position - pv.lift[src] * nh;
-      f.e[k] = g.light.vertices[src] - g.light.vertices[0] - (pv.lift[src] - pv.lift[0]) * nh;
-    }
-  } else {
-    const LocalPolygon<T> c = clip_to_upper_hemisphere(pv.local);
-    bool strictly_above = false;
-    for (int i = 0; i < c.count; ++i) strictly_above = strictly_above || c.v[i].z() > T(0);
-    if (c.count < 3 || !strictly_above) return f.reason = NoSample::kBelowHorizon, f;
-    // A horizon edge (both ends at z = 0) wider than 90 degrees gets its midpoint as an extra vertex. Its ends
-    // are nearly antipodal when the light's plane passes close to x: the fan triangle holding them then has an
-    // edge whose great circle (and Eq. 13's area, 0 / 0) is rounding noise, although the edge lies on the
-    // horizon (found by fuzz_polygon_solid_angle_double: x 2.4e-10 off a rectangle, sample 2.3e-10 rad outside,
-    // issue 7). The midpoint is n x (u_b - u_a), turned towards the light's plane (every direction of the light
-    // has plane_normal . w of the sign of plane_distance): no cancellation. At most one such edge exists, the
-    // horizon part of a polygon in the upper hemisphere spanning at most 180 degrees.
-    // The fan is then rooted at that midpoint. Rooted at a clip point, the fan still had a triangle holding both
-    // nearly antipodal ends of the horizon edge, joined by a diagonal whose great circle is rounding noise
-    // although it should be the horizon (Eq. 13's 0 / 0 again): found by fuzz_polygon_solid_angle_double
-    // (dd70aa66...: x 4.6e-23 off a triangle of size 5e-16, sample 2.9e-10 rad outside; issue 4), and on random
-    // lights seen from 1e-14..1e-2 of their size off their plane samples up to 0.96 rad outside (test_polygon.cpp,
-    // SolidAngleSamplesLieInsideTheLightSeenFromCloseToItsPlane). The midpoint is 90 degrees from both ends; the
-    // clipped polygon lies in the lune between the horizon and the light's plane (seen from x), so within the
-    // lune's angle of the midpoint, and only a lune near 180 degrees (the light's plane close to the tangent plane
-    // with x just below it) brings a vertex near the midpoint's antipode.
-    std::array<Vec3<T>, kMaxFanVertices> q;
-    int nq = 0, root = 0;
-    const Vec3<T> light_normal = pv.frame.to_local(pv.plane_normal);
-    for (int i = 0; i < c.count; ++i) {
-      const Vec3<T>&a = c.v[i], &b = c.v[(i + 1) % c.count];
-      q[nq++] = a;
-      if (a.z() != T(0) || b.z() != T(0) || nq + (c.count - 1 - i) >= kMaxFanVertices) continue;  // room for the rest
-      const Vec3<T> ua = safe_normalized(a), ub = safe_normalized(b);
-      if (!(ua.dot(ub) < T(0))) continue;
-      Vec3<T> mid = safe_normalized(Vec3<T>(ua.y() - ub.y(), ub.x() - ua.x(), T(0)));
-      if (light_normal.dot(mid) * pv.plane_distance < T(0)) mid = -mid;
-      if (!mid.isZero()) root = nq, q[nq++] = mid * ((a.norm() + b.norm()) / T(2)), horizon_rooted = true;
-    }
-    f.count = nq;
-    for (int k = 0; k < nq; ++k) f.p[k] = pv.frame.to_world(q[reverse ? (root - k + nq) % nq : (root + k) % nq]);
-    for (int k = 0; k < nq; ++k) f.e[k] = f.p[k] - f.p[0];
-  }
-  for (int k = 0; k < f.count; ++k) {
-    f.u[k] = safe_normalized(f.p[k]);
-    f.len[k] = f.p[k].stableNorm();
-    if (f.u[k].isZero()) return f.reason = NoSample::kNonFinite, f;
-  }
-  if (!clipped) {
-    // The light's own edge planes (polygon_inward_planes: from the exact world edges V_{j+1} - V_j, not from p_{j+1}
-    // - p_j, whose direction is rounding noise for an edge shorter than the rounding of V - x: its plane rejected
-    // directions 5e-8 rad inside the light, found by fuzz_polygon_solid_angle_double, issue 7; and in the light's
-    // plane, scaled, without a plane for an edge that is a point up to rounding), then the light's plane.
-    const int m = polygon_inward_planes(g, pv, f.inward.data());
-    f.inward[m] = reverse ? Vec3<T>(-pv.plane_normal) : pv.plane_normal;
-    f.planes = m + 1;
-  } else {
-    // The clipped polygon is pv.local's, flattened where the light is non-planar: its planes likewise.
-    const int m = polygon_inward_planes(g, pv, f.inward.data());
-    const T orient = reverse ? T(-1) : T(1);
-    f.inward[m] = pv.normal;  // m <= kMaxPolygonVertices = kMaxFanVertices - 2
-    f.inward[m + 1] = orient * pv.plane_normal;
-    f.planes = m + 2;
-  }
-  if (split_wide_edges) {
-    // An edge wider than 120 degrees gets its midpoint, and the fan is rooted at the first such midpoint (unless
-    // the clipped fan is already rooted at a horizon edge's). Eq. 13 and the sampler's G1, G2 take sums of unit
-    // vectors, and a fan triangle with two nearly antipodal vertices has 1 + u0.uk + u0.uk1 + uk.uk1 = G1 + G2 as
-    // the difference of two numbers near 2 (or a G1 = uk1 . (u0 + uk) whose u0 + uk lost its component along
-    // u0 to rounding), when the triangle's true denominator is as small as the square of the vertices' offsets
-    // from antipodal. That happens for a long light seen from close by, whose vertices all lie near two
-    // antipodal directions (found by fuzz_polygon_solid_angle_double 2a3027c9: a strip 6 wide and 3.9e11 long
-    // seen from 8 off its plane, all seven vertices within 2.5e-10 rad of +-y; the fan triangle (V0, V1, V2)
-    // with V0, V1 near +y and V2 near -y had G1 + G2 = -2 + 2 = 0 instead of ~1e-20, area pi; solid angle
-    // 3.748 instead of 0.686 (Girard's formula from the edge planes, long double), and 3339 of a 65 x 65 grid of
-    // samples outside the light, up to 0.0215 rad; issue 7). The light's edges between the two clusters are the
-    // wide ones: rooted at the midpoint of one, no fan triangle has two nearly antipodal vertices. (120 degrees,
-    // not 90: the horizon midpoint's edges are 90 degrees wide up to rounding, and need no split.) The midpoint of
-    // the edge from u_a to u_b on the great circle of normal m (m . u_a = m . u_b = 0 up to rounding, m pointing
-    // into the cone) is m x (u_a - u_b) (= u_a + u_b up to scale when m = u_a x u_b,
-    // without cancellation for nearly antipodal ends, like the horizon's midpoint above); m is the edge plane of
-    // the cone that holds both ends best: the fan's edges lie on the light's edge planes and on the horizon
-    // (the cone's last plane, the light's own, is not an edge). A convex spherical polygon has a perimeter of at
-    // most 2 pi, so it has at most two edges wider than 120 degrees (kMaxFanVertices, polygon.h).
-    std::array<Vec3<T>, kMaxFanVertices> q;
-    int nq = 0, root = -1;
-    for (int k = 0; k < f.count; ++k) {
-      const int k1 = (k + 1) % f.count;
-      q[nq++] = f.p[k];
-      if (!(f.u[k].dot(f.u[k1]) < T(-0.5)) || nq + (f.count - 1 - k) >= kMaxFanVertices) continue;
-      int best = -1;
-      T best_residual = std::numeric_limits<T>::infinity();
-      for (int j = 0; j + 1 < f.planes; ++j) {
-        const Vec3<T> mj = safe_normalized(f.inward[j]);
-        const T r = std::max(std::abs(mj.dot(f.u[k])), std::abs(mj.dot(f.u[k1])));
-        if (r < best_residual) best_residual = r, best = j;
-      }
-      if (best < 0) continue;
-      Vec3<T> mid = safe_normalized(kahan_cross(safe_normalized(f.inward[best]), Vec3<T>(f.u[k] - f.u[k1])));
-      if (mid.isZero()) continue;
-      // Two planes can hold both ends equally well: a sliver's two long edges lie on one great circle with opposite
-      // inward normals, and the other edge's normal gives the antipode of the midpoint (found by
-      // fuzz_polygon_solid_angle_double c8680af4: a triangle 3.3 long and ~6e-14 wide seen from 0.84, its two
-      // 146-degree edges split at antipodal "midpoints"; solid angle 6.26 instead of ~6e-17 sr, samples 0.7 rad
-      // outside; issue 7). The midpoint lies on the short arc, mid . (u_a + u_b) > 0, and on the light's side of
-      // the plane through x parallel to the light (the cone's last plane), like every direction of the light: its
-      // sign from whichever of the two is larger (u_a + u_b is rounding noise for nearly antipodal ends, the
-      // light's side for x close to its plane).
-      const T by_arc = mid.dot(Vec3<T>(f.u[k] + f.u[k1])), by_side = mid.dot(safe_normalized(f.inward[f.planes - 1]));
-      if ((std::abs(by_arc) >= std::abs(by_side) ? by_arc : by_side) < T(0)) mid = -mid;
-      if (root < 0) root = nq;
-      q[nq++] = mid * ((f.len[k] + f.len[k1]) / T(2));
-    }
-    if (nq > f.count) {
-      if (horizon_rooted || root < 0) root = 0;
-      for (int k = 0; k < nq; ++k) f.p[k] = q[(root + k) % nq];
-      f.count = nq;
-      for (int k = 0; k < f.count; ++k) {
-        f.e[k] = f.p[k] - f.p[0];
-        f.u[k] = safe_normalized(f.p[k]);
-        f.len[k] = f.p[k].stableNorm();
-        if (f.u[k].isZero()) return f.reason = NoSample::kNonFinite, f;
-      }
-    }
-  }
+  if (!clipped)
+    unclipped_fan(g, pv, reverse, f);
+  else if (!clipped_fan(pv, reverse, f, horizon_rooted))
+    return f.reason = NoSample::kBelowHorizon, f;
+  if (!fan_directions(f, false)) return f.reason = NoSample::kNonFinite, f;
+  fan_cone(g, pv, reverse, clipped, f);
+  if (split_wide_edges && !split_wide_fan_edges(f, horizon_rooted)) return f.reason = NoSample::kNonFinite, f;
   return f;
 }
 
@@ -203,7 +178,7 @@ template <class T> bool in_fan_cone(const PolygonFanView<T>& f, const Vec3<T>& w
   return true;
 }
 
-// ---- Peters 2021 Section 5 -------------------------------------------------------------------------------
+// ---- Peters 2021 Section 5 ----
 
 template <class T> struct PolygonSolidAngleView {
   PolygonFanView<T> fan;
@@ -213,10 +188,8 @@ template <class T> struct PolygonSolidAngleView {
   bool valid() const { return reason == NoSample::kNone; }
 };
 
-// Eq. 13 (van Oosterom & Strackee) per fan triangle. G0 = det(v0, v1, v2) is computed as
-// p0 . (e1 x e2) / (|p0| |p1| |p2|) from the light's edges: a determinant of three nearly parallel unit vectors
-// cancels catastrophically for small, distant lights. (Peters uses a Householder reflection, Supplement C,
-// which is not available to us; this is our own remedy.)
+// Eq. 13 (van Oosterom & Strackee) per fan triangle, G0 = det(v0, v1, v2) from the light's edges (no cancellation
+// for small, distant lights; Peters uses a Householder reflection, Supplement C).
 template <class T>
 PolygonSolidAngleView<T> make_polygon_solid_angle_view(const PolygonLightGeometry<T>& g, bool clipped = false) {
   PolygonSolidAngleView<T> v;
@@ -224,18 +197,10 @@ PolygonSolidAngleView<T> make_polygon_solid_angle_view(const PolygonLightGeometr
   if (!v.fan.valid()) return v.reason = v.fan.reason, v;
   const auto& f = v.fan;
   for (int k = 1; k + 1 < f.count; ++k) {
-    // As u_0 . ((e_k / |p_k|) x (e_{k+1} / |p_{k+1}|)): each factor scaled before the product, because
-    // |p_0| |p_k| |p_{k+1}| underflows to 0 for a light ~1e-110 from x (UBSan: division by zero, found by
-    // fuzz_polygon_solid_angle_double 0f46b33f..., issue 7), and the scaled edges have the size of the light's
-    // angular extent.
+    // As u_0 . ((e_k / |p_k|) x (e_{k+1} / |p_{k+1}|)): each factor scaled before the product, which underflows.
     v.g0[k] = f.u[0].dot(kahan_cross(Vec3<T>(f.e[k] / f.len[k]), Vec3<T>(f.e[k + 1] / f.len[k + 1])));
-    // Eq. 13's denominator 1 + u0.uk + u0.uk1 + uk.uk1 = G2 + G1 with G2 = 1 + u0.uk, G1 = uk1 . (u0 + uk), stored
-    // for the sampler, which must use the same values as the area (an area from one rounding and a sample from
-    // another put the sample past the triangle's far edge: 8.9e-8 rad outside a thin fan triangle, found by
-    // fuzz_polygon_solid_angle_double 8ad0e6a8..., issue 7). G2 = 1 + u0.uk cancels for nearly antipodal u0, uk
-    // (x next to the edge or diagonal 0k); there |u0 + uk|^2 / 2 keeps its relative precision down to
-    // |u0 + uk| ~ eps (found by 7739f49d...: x 7e-10 from an edge's midpoint, 1 + u0.u1 = 2.4e-19 computed as
-    // rounding noise, sample 1 rad outside).
+    // Eq. 13's denominator G2 + G1, G2 = 1 + u0.uk (|u0 + uk|^2 / 2 when negative), G1 = uk1 . (u0 + uk), stored for
+    // the sampler.
     const Vec3<T> sum = f.u[0] + f.u[k];
     const T dot = f.u[0].dot(f.u[k]);
     v.g2[k] = dot < T(0) ? sum.squaredNorm() / T(2) : T(1) + dot;
@@ -244,7 +209,7 @@ PolygonSolidAngleView<T> make_polygon_solid_angle_view(const PolygonLightGeometr
     v.area[k] = std::max(T(0), T(2) * std::atan2(v.g0[k], denom));
     v.solid_angle += v.area[k];
   }
-  // 1 / Omega must be representable too (as for the projected solid angle; issue 7).
+  // 1 / Omega must be representable too.
   if (!(v.solid_angle > T(0)) || !std::isfinite(v.solid_angle) || !std::isfinite(T(1) / v.solid_angle))
     v.reason = NoSample::kTooSmall;
   return v;
@@ -264,21 +229,9 @@ int pick_fan_triangle(const std::array<T, N>& area, int count, T target, T* rema
   return k;
 }
 
-// Arvo's second step (Arvo 1995; used by Section 5): a direction on the arc from b towards c (unit vectors)
-// at the angle phi from b with 1 - cos(phi) = xi (1 - b.c), given d = c - b (accurately).
-// Our formulation, in half angles of the arc's angle theta: sin(theta/2) = |d| / 2, cos(theta/2) = |b + c| / 2,
-//   sin(phi/2) = sqrt(xi) sin(theta/2),  cos(phi/2) = sqrt(cos^2(theta/2) + (1 - xi) sin^2(theta/2)),
-// and for the rest psi = theta - phi, without cancellation,
-//   sin(psi/2) = (1 - xi) sin^2(theta/2) / (sin(theta/2) cos(phi/2) + cos(theta/2) sin(phi/2)).
-// The point is measured from the nearer end (tangents t_b towards c, t_c towards b): cos(phi) b + sin(phi) t_b
-// or cos(psi) c + sin(psi) t_c. A tangent is the component of the other end orthogonal to this one, made
-// orthogonal once more after the subtraction: for nearly antipodal ends that component is as small as the ends'
-// distance from antipodal and carries their rounding. Written from b alone, as b (1 - xi h) + sqrt(xi h (2 - xi h)) t_b
-// with h = 1 - b.c, the far end of an arc between nearly antipodal b and c came out as -b: 2 - xi h cancels, and c's
-// small offset from -b was lost. Such arcs occur in fan triangles that are nearly hemispheres (x close to the light's
-// plane, above the triangle): on random lights seen from 1e-14..1e-2 of their size off their plane, samples up
-// to 1.6e-8 rad outside in double (test_polygon.cpp, SolidAngleSamplesLieInsideTheLightSeenFromCloseToItsPlane; our
-// remedy, issue 4).
+// Arvo's second step (Arvo 1995; used by Section 5): the direction on the arc from b towards c (unit) with
+// 1 - cos(phi) = xi (1 - b.c), given d = c - b, in half angles of the arc (sin(theta/2) = |d| / 2): sin(phi/2) =
+// sqrt(xi) sin(theta/2), and the rest psi = theta - phi without cancellation; measured from the nearer end.
 template <class T> Vec3<T> sample_arc(const Vec3<T>& b, const Vec3<T>& d, T xi) {
   const Vec3<T> c = b + d, sum = b + c;
   T sh = d.norm() / T(2), ch = sum.norm() / T(2);
@@ -303,11 +256,8 @@ template <class T> T pdf_polygon_solid_angle(const PolygonSolidAngleView<T>& v, 
   return T(1) / v.solid_angle;
 }
 
-// Section 5: the new vertex v2' on the edge v0 v2 with triangle (v0, v1, v2') of solid angle A:
-//   r = (G0 cos(A/2) - G1 sin(A/2)) v0 + G2 sin(A/2) v2,  v2' = -v0 + 2 (v0.r / |r|^2) r,
-// rewritten without cancellation as v2' = v0 + 2 r x (r x v0) / |r|^2 (the identity a x (b x c) =
-// b (a.c) - c (a.b)), where r x v0 = G2 sin(A/2) (v2 x v0) and v2 x v0 = (e2 x p0) / (|p2| |p0|).
-// Then Arvo's arc sampling from v1 to v2' with xi_1.
+// Section 5: v2' on the edge v0 v2 with triangle (v0, v1, v2') of solid angle A, r = (G0 cos(A/2) - G1 sin(A/2)) v0 +
+// G2 sin(A/2) v2, v2' = -v0 + 2 (v0.r / |r|^2) r = v0 + 2 r x (r x v0) / |r|^2 (no cancellation); then Arvo's arc.
 template <class T> DirectionSample<T> sample_polygon_solid_angle(const PolygonSolidAngleView<T>& v, const Vec2<T>& u) {
   if (!v.valid()) return DirectionSample<T>::none(v.reason);
   const auto& f = v.fan;
@@ -339,14 +289,12 @@ template <class T> T pdf_polygon_solid_angle(const PolygonLightGeometry<T>& g, c
   return pdf_polygon_solid_angle(make_polygon_solid_angle_view(g, clipped), w);
 }
 
-// ---- Baseline: Arvo 1995, "Stratified Sampling of Spherical Triangles", as published ---------------------
+// ---- Baseline: Arvo 1995, "Stratified Sampling of Spherical Triangles", as published ----
 //
-// Per triangle (A, B, C) with interior angles alpha, beta, gamma and area alpha + beta + gamma - pi:
+// Per fan triangle (A, B, C), area alpha + beta + gamma - pi (cancels for small triangles: kept on purpose):
 //   A^ = xi_1 area; s = sin(A^ - alpha); t = cos(A^ - alpha); u = t - cos alpha; v = s + sin alpha cos c;
 //   q = ((v t - u s) cos alpha - v) / ((v s + u t) sin alpha);  C^ = q A + sqrt(1 - q^2) |C - (C.A) A|^;
 //   z = 1 - xi_2 (1 - C^.B);  P = z B + sqrt(1 - z^2) |C^ - (C^.B) B|^
-// (c is the arc AB). Polygons are sampled as the fan (v0, v_k, v_{k+1}), triangles chosen by Arvo's areas.
-// The angle sum cancels for small triangles: that is the published method's weakness, kept on purpose.
 
 template <class T> struct ArvoFanView {
   PolygonFanView<T> fan;
@@ -387,8 +335,7 @@ template <class T> DirectionSample<T> sample_arvo_triangle_fan(const ArvoFanView
   const T alpha = v.alpha[k];
   const T s = std::sin(ahat - alpha), t = std::cos(ahat - alpha);
   const T uu = t - std::cos(alpha), vv = s + std::sin(alpha) * A.dot(B);
-  // Arvo 1995's q; a zero denominator (found by the sanitizer replay of fuzz_polygon_arvo_*: float-divide-by-zero)
-  // takes the limit of the clamped quotient, +-1 by the numerator's sign, without dividing.
+  // Arvo 1995's q; a zero denominator takes the limit of the clamped quotient, +-1 by the numerator's sign.
   const T q_num = (vv * t - uu * s) * std::cos(alpha) - vv, q_den = (vv * s + uu * t) * std::sin(alpha);
   const T q = q_den != T(0) ? std::clamp(q_num / q_den, T(-1), T(1)) : (q_num < T(0) ? T(-1) : T(1));
   const Vec3<T> chat = q * A + std::sqrt(T(1) - q * q) * safe_normalized(Vec3<T>(C - C.dot(A) * A));
@@ -410,7 +357,7 @@ template <class T> T pdf_arvo_triangle_fan(const PolygonLightGeometry<T>& g, con
   return T(1) / v.solid_angle;
 }
 
-// ---- Baseline: Turk 1992, "Generating Random Points in Triangles", as published ---------------------------
+// ---- Baseline: Turk 1992, "Generating Random Points in Triangles", as published ----
 //
 // A fan triangle is chosen in proportion to its area, then P = (1 - sqrt(xi_0)) A + sqrt(xi_0) (1 - xi_1) B
 // + sqrt(xi_0) xi_1 C (xi_0 rescaled within the chosen triangle).

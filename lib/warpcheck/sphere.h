@@ -1,20 +1,14 @@
 // warpcheck/sphere.h: sphere lights, sampled by solid angle and by visible area.
 //
-// Both kernels share one per-light precomputation, SphereView (the cone of directions the light subtends), in
-// the spirit of the per-light / per-sample split of Peters & Dachsbacher 2019, Section 3.7.
+// Both kernels share one per-light view, SphereView (the cone the light subtends; Peters & Dachsbacher 2019 Sec. 3.7).
 //
-// Solid-angle sampling follows Wang 1992 / Shirley 1996 Section 3.2.2 as retold by Schutte 2018: uniform in
-// the cone of half-angle theta_max = asin(r / d) around the direction to the centre,
-//   cos(theta) = 1 - u0 (1 - cos(theta_max)),  phi = 2 pi u1,  pdf = 1 / (2 pi (1 - cos(theta_max))).
-// The whole cone is sampled, also where part of it is below the shading horizon (those samples carry a zero
-// cosine for the caller); only a light entirely below the horizon gives "no sample".
+// Solid angle (Wang 1992 / Shirley 1996 Sec. 3.2.2, as retold by Schutte 2018): uniform in the cone of half-angle
+// theta_max = asin(r / d), cos(theta) = 1 - u0 (1 - cos(theta_max)), phi = 2 pi u1, pdf = 1 / (2 pi (1 - cos)).
+// The whole cone is sampled, also below the shading horizon; only a light entirely below it gives "no sample".
 //
-// Area sampling samples uniformly the *visible cap* of the sphere (the part of its surface seen from the
-// shading point: angle alpha at the centre from the direction to the point with cos(alpha) >= r / d, area
-// A = 2 pi r^2 (1 - r / d)), not the whole sphere: a whole-sphere sampler wastes half its samples on the
-// self-occluded back and maps two points to each direction. The density is reported per solid angle,
-//   pdf(w) = dist^2 / (cos_light A),
-// which grows without bound towards the silhouette (cos_light -> 0); it is integrable there.
+// Visible area: uniform on the visible cap (cos(alpha) >= r / d at the centre, area A = 2 pi r^2 (1 - r / d)), not
+// the whole sphere, whose back is self-occluded. pdf(w) = dist^2 / (cos_light A) per solid angle, unbounded but
+// integrable towards the silhouette.
 #pragma once
 
 #include "warpcheck/core.h"
@@ -34,8 +28,9 @@ template <class T> struct SphereLightGeometry {
 // Per-light precomputation shared by both sphere kernels.
 template <class T> struct SphereView {
   NoSample reason = NoSample::kNone;
-  Vec3<T> normal;              // unit shading normal
-  Frame<T> frame;              // z: unit direction from the shading point to the centre
+  Vec3<T> normal = Vec3<T>::Zero();  // unit shading normal
+  // z: the unit direction from the shading point to the centre
+  Frame<T> frame = Frame<T>::from_z(Vec3<T>(T(0), T(0), T(1)));
   T distance = T(0);           // d = |c - x|
   T sin2_theta_max = T(0);     // (r / d)^2
   T one_minus_cos_max = T(0);  // 1 - cos(theta_max), computed without cancellation
@@ -68,17 +63,15 @@ template <class T> SphereView<T> make_sphere_view(const SphereLightGeometry<T>& 
   v.cos_theta_max = cos_max;
   // 1 - cos = sin^2 / (1 + cos): no cancellation for tiny cones.
   v.one_minus_cos_max = v.sin2_theta_max / (T(1) + cos_max);
-  // The density 1 / (2 pi (1 - cos)) must be representable too: r / d ~ 4e-155 in double gives a subnormal
-  // 1 - cos ~ 7e-310 whose density overflows to Inf (found by fuzz_sphere_double, issue 7).
+  // The density 1 / (2 pi (1 - cos)) must be representable (r / d ~ 4e-155 in double overflows it).
   if (!(v.one_minus_cos_max > T(0)) || !std::isfinite(T(1) / (kTwoPi<T> * v.one_minus_cos_max)))
     return v.reason = NoSample::kTooSmall, v;
-  // Entirely below the horizon: the angle between the normal and the axis is at least pi/2 + theta_max,
-  // i.e. n.axis <= -sin(theta_max).
+  // Entirely below the horizon: n.axis <= -sin(theta_max).
   if (v.normal.dot(v.frame.z) <= -s) return v.reason = NoSample::kBelowHorizon, v;
   return v;
 }
 
-// ---- Solid-angle sampling (Shirley 1996, Sec. 3.2.2) --------------------------------------------------
+// ---- Solid-angle sampling (Shirley 1996, Sec. 3.2.2) ----
 
 template <class T> T sphere_solid_angle_density(const SphereView<T>& v) {
   return T(1) / (kTwoPi<T> * v.one_minus_cos_max);
@@ -111,7 +104,7 @@ template <class T> T pdf_sphere_solid_angle(const SphereLightGeometry<T>& g, con
   return pdf_sphere_solid_angle(make_sphere_view(g), w);
 }
 
-// ---- Visible-cap area sampling -------------------------------------------------------------------------
+// ---- Visible-cap area sampling ----
 
 template <class T>
 DirectionSample<T> sample_sphere_visible_area(const SphereView<T>& v, const SphereLight<T>& light, const Vec2<T>& u) {
@@ -127,10 +120,8 @@ DirectionSample<T> sample_sphere_visible_area(const SphereView<T>& v, const Sphe
   // p - x = d z + r m, m = (sin_a cos phi, sin_a sin phi, -cos_a).
   const Vec3<T> local(r * sin_a * std::cos(phi), r * sin_a * std::sin(phi), d - r * cos_a);
   const T dist = local.stableNorm();
-  // |p - x| beyond the largest finite T (a light of radius ~1e308): the density dist^3 / ... is not representable
-  // either, so there is no sample; checked before local / dist, which would be 0 and its renormalisation a
-  // division by zero (found by fuzz_sphere_double cf221826, UBSan, issue 7; the sample was already discarded, as its
-  // pdf was Inf).
+  // |p - x| beyond T's range (radius ~1e308): the density is not representable either. Tested before local / dist,
+  // whose renormalisation would divide by zero.
   if (!std::isfinite(dist)) return DirectionSample<T>::none(NoSample::kTooSmall);
   // cos_light * dist = -m.(p - x) = d cos_a - r = (d - r)(1 - u0): exact algebra, no cancellation.
   const T cos_light_times_dist = (d - r) * (T(1) - u[0]);
@@ -148,11 +139,8 @@ template <class T> DirectionSample<T> sample_sphere_visible_area(const SphereLig
   return sample_sphere_visible_area(make_sphere_view(g), g.light, u);
 }
 
-// Density of the visible-cap area sampler in direction w: intersect the ray with the sphere (nearest hit),
-// then dist^2 / (cos_light A). In the view frame (centre at (0, 0, d)), with theta the angle of w from the
-// axis, the ray passes the centre at distance d sin(theta); q = d sin(theta) / r <= 1 inside the cap,
-// cos_light = sqrt(1 - q^2) = sqrt((1 - q)(1 + q)) and the nearest hit is at t = d cos(theta) - r cos_light.
-// Everything is scaled by r so that huge d / r does not overflow.
+// Density of the visible-cap area sampler: dist^2 / (cos_light A) at the ray's nearest hit. With q = d sin(theta) / r,
+// cos_light = sqrt((1 - q)(1 + q)) and t = d cos(theta) - r cos_light, all scaled by r (no overflow for huge d / r).
 template <class T> T pdf_sphere_visible_area(const SphereView<T>& v, const SphereLight<T>& light, const Vec3<T>& w) {
   if (!v.valid() || !all_finite(w)) return T(0);
   if (!v.cap().contains(w)) return T(0);
