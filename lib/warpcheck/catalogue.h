@@ -66,4 +66,11 @@ using SptdKernels = KernelList<SptdUniformCap, SptdCosineCap, PolygonLtc>;
 
 using AllKernels = JoinKernelLists<SphereKernels, ProjectedCapKernels, PolygonKernels, SptdKernels>::type;
 
+template <class K> constexpr bool kernel_takes_only_rectangles() {
+  if constexpr (requires { K::rectangles_only; })
+    return K::rectangles_only;
+  else
+    return false;
+}
+
 }  // namespace warpcheck

@@ -646,8 +646,8 @@ template <class T> T pdf_polygon_projected_solid_angle_biased(const PolygonLight
 template <class T, bool kBiased> struct PolygonProjectedSolidAngleKernel {
   static constexpr const char* name =
       kBiased ? "polygon-projected-solid-angle-biased" : "polygon-projected-solid-angle";
-  static constexpr const char* description = kBiased ? "projected solid angle, Peters 2021 Sec. 6.4 (biased)"
-                                                     : "projected solid angle, Peters 2021 Sec. 3 (2 iterations)";
+  static constexpr const char* description = kBiased ? "projected solid angle, Peters 2021 Sec. 6.4, biased"
+                                                     : "projected solid angle, Peters 2021 Sec. 3 with 2 iterations";
   using Scalar = T;
   using Geometry = PolygonLightGeometry<T>;
   using View = PolygonProjectedView<T>;

@@ -776,11 +776,12 @@ template <class T> Cap<T> projected_cap_bounding_cap(const ProjectedCapView<T>& 
 
 // M = kQuintic is the paper's sampler (Alg. 5's quintic); kExact inverts A(X) exactly.
 template <class T, CutDiskInverse M> struct SphereProjectedCapKernel {
+  static constexpr CutDiskInverse inverse = M;
   static constexpr bool kQuintic = M == CutDiskInverse::kQuintic;
   static constexpr const char* name = kQuintic ? "sphere-projected-cap" : "sphere-projected-cap-exact";
-  static constexpr const char* description = kQuintic
-                                                 ? "projected solid angle, Peters & Dachsbacher 2019 (quintic)"
-                                                 : "projected solid angle, Peters & Dachsbacher 2019 (exact inverse)";
+  static constexpr const char* description =
+      kQuintic ? "projected solid angle, Peters & Dachsbacher 2019 with the quintic"
+               : "projected solid angle, Peters & Dachsbacher 2019 with the exact inverse";
   using Scalar = T;
   using Geometry = SphereLightGeometry<T>;
   using View = ProjectedCapView<T>;

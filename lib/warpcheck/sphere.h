@@ -175,7 +175,7 @@ template <class T> T pdf_sphere_visible_area(const SphereLightGeometry<T>& g, co
 
 template <class T> struct SphereSolidAngle {
   static constexpr const char* name = "sphere-solid-angle";
-  static constexpr const char* description = "uniform in the light's cone (Shirley 1996)";
+  static constexpr const char* description = "uniform in the light's cone, Shirley 1996";
   using Scalar = T;
   using Geometry = SphereLightGeometry<T>;
   using View = SphereView<T>;

@@ -770,6 +770,7 @@ SptdCapGeometry<T> pivot_phase_sphere_light_geometry(const Vec3<T>& wo, T gp, co
 // function (pivot_phase_geometry) and its joint sampling with a sphere light (pivot_phase_sphere_light_geometry)
 // are the uniform kernel on particular geometry.
 template <class T, SptdBase B> struct SptdCapKernel {
+  static constexpr SptdBase base = B;
   static constexpr bool kUniform = B == SptdBase::kUniform;
   static constexpr const char* name = kUniform ? "sptd-uniform-cap" : "sptd-cosine-cap";
   static constexpr const char* description =
