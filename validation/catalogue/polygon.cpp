@@ -130,7 +130,7 @@ std::vector<PolygonConfig> configs() {
 //    1e7): chi2 and KS p < 1e-45 for every kernel, pdf-consistency 1 (a sample's direction outside the light).
 //    Peters 2021 Sec. 3.7 recommends area sampling here; in float that is no cure either.
 //  * Arvo 1995 and Urena et al. 2013 in float on nearly-edge-on: normalisers off by 2.6e-4 and 3.8e-3 (the same
-//    cancellation; float battery at 1e7 samples, 2026-12-02).
+//    cancellation; float battery at 1e7 samples).
 //  * Arvo 1995 and Urena et al. 2013 in float on both far lights: their solid angles (angle sums minus pi resp.
 //    2 pi) cancel: 1 cm, 0 (Arvo: no samples) and -2.4e-7 (Urena) for 5.3e-8 sr; 1 mm, 0 and 2.4e-7 for 5.3e-10.
 const char* polygon_known_limitation(const std::string& kernel, const std::string& scalar, const std::string& config) {
@@ -203,11 +203,8 @@ template <template <class> class K, class T> SamplerUnderTest make_sampler(const
   SamplerUnderTest s = bind_kernel<K<T>, K<Real>>(c.name, c.g.template cast<T>(), c.g);
   s.expect_no_sample = !K<Real>::sample(K<Real>::view(c.g), Vec2<Real>(0.5L, 0.5L)).valid();
   // Breakpoints only for slivers (thinner than a sixteenth of the bounding cap's radius, the default grid's
-  // ring spacing): they multiply the quadrature's cost (measured on central-square, projected kernel: double,
-  // 1000 samples, 19.9 s -> 78.6 s of CPU), and the default nodes already resolve every other configuration
-  // (the double battery of 9ec2b69 passed them all). In float they cost most in the KS rings, whose lines
-  // barely touching the support ran to their panel budget until ks_cdfs got an absolute tolerance (battery.cpp:
-  // nearly-edge-on float, 1136 s -> 160 s of CPU in the rings).
+  // ring spacing): they multiply the quadrature's cost (about 4x on central-square), and the default nodes
+  // resolve every other configuration.
   const Real theta_max = std::acos(std::clamp<Real>(1 - s.bounding_cap.one_minus_cos, -1, 1));
   if (angular_width(c.g, polygon_edge_planes(c.g)) < theta_max / 16) s.boundary_planes = K<Real>::boundary_planes(c.g);
   if (s.expect_no_sample) return s;

@@ -82,18 +82,16 @@ std::vector<ProjectedCapConfig> projected_cap_configs() {
 }
 
 // float's tolerance per configuration: twice the largest deterministic statistic (pdf-consistency, pdf-integral,
-// normalisations, hit bias) of either float kernel, rounded up to one digit, at least the shared 1e-6. Measured
-// 2026-12-02 at commit ef014ba (the battery evaluating the reference at the float-rounded primary sample) with
-//   warpcheck validate --kernel 'sphere-projected-cap*' --scalar float --threads 2
-// (1e7 samples, 880 s; all 78 chi2/KS tests pass, smallest p 3.8e-4, Holm at 0.01). The measured value is in
-// each comment; what limits it:
+// normalisations, hit bias) of either float kernel, rounded up to one digit, at least the shared 1e-6, measured
+// with
+//   warpcheck validate --kernel 'sphere-projected-cap*' --scalar float
+// (1e7 samples; all 78 chi2/KS tests pass, smallest p 3.8e-4, Holm at 0.01). The measured value is in each
+// comment; what limits it:
 //  * near-touching (d = 1.001 r): cos(theta_max) = sqrt(1 - (r/d)^2) loses ~1e-5 to the cancellation, inherent
 //    in float when d is only known to eps d (see ProjectedCapFloat.SamplePdfsNearTheHorizonKeepTheirDigits);
 //  * near-touching-case3: Case 3's w_x = sqrt(1 - w_y^2 - w_z^2) (pdf(dir) agrees with pdf to 3.8e-5 only);
 //  * tiny (2e-3 rad): pdf-integral 1e-5 low, the float cap's edge is rounded by ~eps / theta_max of its width;
 //  * case3-sliver: the lune is 1% of the radius high, its heights a few eps_float wide.
-// Before a43fe14 (heights, left-areas and right-areas with cancellation) the deterministic checks measured 1.2e-5
-// to 3.1e-3 and tiny-straddling failed outright (pdf-integral 0.959, chi2 statistic 4e5).
 Real projected_cap_float_tolerance(const std::string& config) {
   struct Entry {
     const char* config;

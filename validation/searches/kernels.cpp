@@ -11,8 +11,7 @@
 // counted. A point where either instantiation declines to sample is outside the search (NaN): declines are
 // the battery's and the fuzzers' business, not an error of a returned sample. u stays 1e-6 away from 0 and 1:
 // exactly there the warps reach measure-zero boundaries (zero-area sectors, silhouettes, the poles of polar
-// maps) where float and long double may pick different but equally valid boundary points; a first 2-s run
-// with u in [0, 1] found 0.88 rad "errors" of that kind at u0 = 0 in polygon-projected-solid-angle (double).
+// maps) where float and long double may pick different but equally valid boundary points (up to ~1 rad apart).
 //
 // Derivatives: fourth-order central differences of the long double warp, (-f(+2h) + 8 f(+h) - 8 f(-h) +
 // f(-2h)) / 12h. Hand-rolled because Boost.Math's autodiff would need every kernel (Eigen expressions,

@@ -64,8 +64,8 @@ struct SamplerUnderTest {
   std::vector<Real> kinks_u0, kinks_u1;
   // Optional independent normalisation checks.
   std::vector<Normalization> normalizations;
-  // Relative tolerance of the deterministic checks (pdf consistency, integral, normalisation). The
-  // issue's 1e-6 for double and long double; a float sampler states its own, measured, tolerance.
+  // Relative tolerance of the deterministic checks (pdf consistency, integral, normalisation): 1e-6 for double
+  // and long double; a float sampler states its own, measured, tolerance.
   Real tolerance = 1e-6L;
   // Why the tolerance differs from 1e-6, if it does (printed in the JSON results).
   std::string tolerance_note;
