@@ -108,8 +108,11 @@ TEST(Catalogue, TheStoredBenchmarksNameOnlyCatalogueKernels) {
   for (const auto& e : fs::directory_iterator(kData / "bench")) {
     if (e.path().extension() != ".json") continue;
     ++files;
-    for (const std::string& b : benchmark_names(e.path()))
-      if (const auto k = kernel_of_benchmark(b)) EXPECT_TRUE(in_catalogue(*k)) << e.path().filename() << ": " << b;
+    for (const std::string& b : benchmark_names(e.path())) {
+      if (const auto k = kernel_of_benchmark(b)) {
+        EXPECT_TRUE(in_catalogue(*k)) << e.path().filename() << ": " << b;
+      }
+    }
   }
   EXPECT_GT(files, 0);
 }
