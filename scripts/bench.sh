@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Issue 9's one command: run the kernel benchmarks (Google Benchmark JSON into data/bench/results.json) and
-# print the ratio table (validation/tools/bench_table.cpp).
+# Runs the kernel benchmarks (Google Benchmark JSON into data/bench/results.json) and prints the ratio table
+# (validation/tools/bench_table.cpp).
 #   scripts/bench.sh                      build dir build/, --benchmark_min_time=0.5s
 #   BUILD=build-bench MIN_TIME=0.05 scripts/bench.sh [extra benchmark args, e.g. --benchmark_filter=sphere]
 # Builds warpcheck_bench and bench_table with one job. Timings on a loaded machine are unreliable: the JSON

@@ -1,27 +1,28 @@
-// Google Benchmark of the kernels in the papers' configurations (issue 9).
+// Google Benchmark of every kernel of lib/warpcheck/catalogue.h in the papers' configurations.
 //
-// Names: KERNEL/SCALAR/CONFIG/spl=S, S samples per light. spl=1: each iteration takes kLights lights, one
-// precomputation (view) and one sample each. spl=500: each iteration takes one light, one precomputation and
-// 500 samples (Peters & Dachsbacher 2019 Sec. 3.7 split). items_per_second counts samples, so the time per
-// sample is 1 / items_per_second. "baseline" only reads the random numbers (and the geometry, for spl=1):
-// the papers subtract such a baseline (2019 Table 2; 2021 Table 1), and so does bench_table.
+// Names: KERNEL/SCALAR/CONFIG/spl=S, KERNEL the catalogue name, S samples per light. spl=1: each iteration takes
+// kLights lights, one precomputation (view) and one sample each. spl=500: each iteration takes one light, one
+// precomputation and 500 samples (Peters & Dachsbacher 2019 Sec. 3.7 split). items_per_second counts samples, so
+// the time per sample is 1 / items_per_second. "baseline" only reads the random numbers (and the geometry, for
+// spl=1): the papers subtract such a baseline (2019 Table 2; 2021 Table 1), and so does bench_table.
+// sphere-solid-angle/SCALAR/CONFIG/spl=500/batch is the batch API (batch.h) of the same kernel.
 //
-// Configurations:
+// Configurations, by the kernel's geometry:
 //  sphere  qz=Q     Peters & Dachsbacher 2019 Fig. 9 / Table 2: the plane z = 0 (normal +z) lit by a unit
 //                   sphere centred at (0, 0, Q), Q in {2, 0.1, -0.1, -0.9}. Shading points uniform in the
 //                   square [-4, 4]^2 of the plane (our choice: the paper's camera is not given), excluding
 //                   points within distance 1.01 of the centre (inside or on the light).
-//  polygon central-N / decentral-N   Peters 2021 Table 1: a regular N-gon (N = 3, 4, 5) of circumradius 1,
-//                   horizontal at height 1 above the plane z = 0 (normal +z). Central (the polygon contains
-//                   the zenith, Fig. 3): shading points uniform in the disk of radius 0.3 below its centre.
-//                   Decentral: shading points at horizontal distance 2 to 4 from its centre.
-// Kernels the papers do not time (no target; in the JSON for the report):
-//  polygon_ltc      the polygon scenes with the battery's "random" LTC (registry_sptd.cpp), its third row set to
+//  polygon central-N / decentral-N   Peters 2021 Table 1: a regular N-gon (N = 3, 4, 5; 4 only for kernels that
+//                   take rectangles only) of circumradius 1, horizontal at height 1 above the plane z = 0 (normal
+//                   +z). Central (the polygon contains the zenith, Fig. 3): shading points uniform in the disk of
+//                   radius 0.3 below its centre. Decentral: shading points at horizontal distance 2 to 4 from its
+//                   centre.
+//  LTC              the polygon scenes with the battery's "random" LTC (catalogue/sptd.cpp), its third row set to
 //                   (0, 0, 1) so that M^-1 keeps every light above the horizon (with the row -0.37, 0.075, 1 about
 //                   21% of the decentral lights had no sample);
-//  sptd_uniform_cap / sptd_cosine_cap   the sphere scenes' caps (the light's cone from the shading point) under an
-//                   SPTD with pivot (0.2, 0.1, 0.5) in world space (|r_p| 0.55) and, for the clamped cosine, base
-//                   axis +z.
+//  SPTD cap         the sphere scenes' caps (the light's cone from the shading point) under an SPTD with pivot
+//                   (0.2, 0.1, 0.5) in world space (|r_p| 0.55) and, for the clamped cosine, base axis +z.
+// The LTC and SPTD geometry is formed from the scene's light inside the timed loop, with the view.
 // Random numbers: pre-generated with std::mt19937_64 seed 1, as T, in [0, 1).
 #include <benchmark/benchmark.h>
 
@@ -30,13 +31,7 @@
 #include <vector>
 
 #include "warpcheck/batch.h"
-#include "warpcheck/ltc.h"
-#include "warpcheck/polygon_projected.h"
-#include "warpcheck/polygon_solid_angle.h"
-#include "warpcheck/projected_cap.h"
-#include "warpcheck/sphere.h"
-#include "warpcheck/spherical_rectangle.h"
-#include "warpcheck/sptd.h"
+#include "warpcheck/catalogue.h"
 
 namespace warpcheck {
 namespace {
@@ -88,24 +83,24 @@ template <class T> std::vector<PolygonLightGeometry<T>> polygon_scene(int n, boo
   return out;
 }
 
-// Runs `sample(make_view(g), u)` in the two modes; accumulates outputs so nothing is optimised away.
-template <class T, class G, class MakeView, class Sample>
-void run(benchmark::State& state, const std::vector<G>& scene, MakeView make_view, Sample sample, int spl) {
+// Runs K::sample(K::view(to_geometry(light)), u) in the two modes; accumulates outputs so nothing is optimised away.
+template <template <class> class K, class T, class Light, class ToGeometry>
+void run(benchmark::State& state, const std::vector<Light>& scene, ToGeometry to_geometry, int spl) {
   static const RandomNumbers<T> rn(kLights * kManySamples);
   T acc = 0;
   std::size_t light = 0, offset = 0, declined = 0;
   for (auto _ : state) {
     if (spl == 1) {
       for (int i = 0; i < kLights; ++i) {
-        const auto s = sample(make_view(scene[i]), Vec2<T>(rn.u0[offset + i], rn.u1[offset + i]));
+        const auto s = K<T>::sample(K<T>::view(to_geometry(scene[i])), Vec2<T>(rn.u0[offset + i], rn.u1[offset + i]));
         acc += s.direction.x() + s.pdf;
         declined += !s.valid();
       }
       offset = (offset + kLights) % (rn.u0.size() - kLights);
     } else {
-      const auto v = make_view(scene[light]);
+      const auto v = K<T>::view(to_geometry(scene[light]));
       for (int i = 0; i < kManySamples; ++i) {
-        const auto s = sample(v, Vec2<T>(rn.u0[offset + i], rn.u1[offset + i]));
+        const auto s = K<T>::sample(v, Vec2<T>(rn.u0[offset + i], rn.u1[offset + i]));
         acc += s.direction.x() + s.pdf;
         declined += !s.valid();
       }
@@ -153,110 +148,82 @@ template <class T> void run_batch(benchmark::State& state, const std::vector<Sph
   state.SetItemsProcessed(state.iterations() * kManySamples);
 }
 
-template <class T> void register_all() {
-  const std::string t = std::is_same_v<T, float> ? "float" : "double";
+template <class Light> struct Scene {
+  std::string config;
+  std::vector<Light> lights;
+  int vertices = 0;  // polygons
+};
+
+template <class T> std::vector<Scene<SphereLightGeometry<T>>> scenes(const SphereLightGeometry<T>*) {
+  std::vector<Scene<SphereLightGeometry<T>>> out;
   for (double qz : {2.0, 0.1, -0.1, -0.9}) {
-    const auto scene = sphere_scene<T>(qz);
     char qs[16];
     std::snprintf(qs, sizeof qs, "qz=%g", qz);
-    for (int spl : {1, kManySamples}) {
-      const std::string suffix = "/" + t + "/" + qs + "/spl=" + std::to_string(spl);
-      benchmark::RegisterBenchmark(("sphere_baseline" + suffix).c_str(),
-                                   [=](benchmark::State& s) { run_baseline<T>(s, scene, spl); });
-      benchmark::RegisterBenchmark(("sphere_solid_angle" + suffix).c_str(), [=](benchmark::State& s) {
-        run<T>(
-            s, scene, [](const auto& g) { return make_sphere_view(g); },
-            [](const auto& v, const Vec2<T>& u) { return sample_sphere_solid_angle(v, u); }, spl);
-      });
-      benchmark::RegisterBenchmark(("sphere_visible_area" + suffix).c_str(), [=](benchmark::State& s) {
-        run<T>(
-            s, scene, [](const auto& g) { return std::make_pair(make_sphere_view(g), g.light); },
-            [](const auto& v, const Vec2<T>& u) { return sample_sphere_visible_area(v.first, v.second, u); }, spl);
-      });
-      benchmark::RegisterBenchmark(("projected_cap" + suffix).c_str(), [=](benchmark::State& s) {
-        run<T>(
-            s, scene, [](const auto& g) { return make_projected_cap_view(g); },
-            [](const auto& v, const Vec2<T>& u) { return sample_projected_spherical_cap(v, u); }, spl);
-      });
-      for (const SptdBase base : {SptdBase::kUniform, SptdBase::kClampedCosine}) {
-        const std::string name = base == SptdBase::kUniform ? "sptd_uniform_cap" : "sptd_cosine_cap";
-        benchmark::RegisterBenchmark((name + suffix).c_str(), [=](benchmark::State& s) {
-          run<T>(
-              s, scene,
-              [base](const auto& g) {
-                SptdCapGeometry<T> c;
-                c.sptd.pivot = Vec3<T>(T(0.2), T(0.1), T(0.5));
-                c.sptd.base = base;
-                c.cap = make_sphere_view(g).cap();
-                return make_sptd_cap_view(c);
-              },
-              [](const auto& v, const Vec2<T>& u) { return sample_sptd_cap(v, u); }, spl);
-        });
-      }
-      if (spl == kManySamples)
-        benchmark::RegisterBenchmark(("sphere_solid_angle_batch" + suffix).c_str(),
-                                     [=](benchmark::State& s) { run_batch<T>(s, scene); });
-    }
+    out.push_back({qs, sphere_scene<T>(qz)});
   }
-  for (bool central : {true, false}) {
-    for (int n : {3, 4, 5}) {
-      const auto scene = polygon_scene<T>(n, central);
-      for (int spl : {1, kManySamples}) {
-        const std::string suffix =
-            "/" + t + "/" + (central ? "central-" : "decentral-") + std::to_string(n) + "/spl=" + std::to_string(spl);
-        benchmark::RegisterBenchmark(("polygon_baseline" + suffix).c_str(),
-                                     [=](benchmark::State& s) { run_baseline<T>(s, scene, spl); });
-        benchmark::RegisterBenchmark(("polygon_solid_angle" + suffix).c_str(), [=](benchmark::State& s) {
-          run<T>(
-              s, scene, [](const auto& g) { return make_polygon_solid_angle_view(g, false); },
-              [](const auto& v, const Vec2<T>& u) { return sample_polygon_solid_angle(v, u); }, spl);
-        });
-        benchmark::RegisterBenchmark(("polygon_solid_angle_clipped" + suffix).c_str(), [=](benchmark::State& s) {
-          run<T>(
-              s, scene, [](const auto& g) { return make_polygon_solid_angle_view(g, true); },
-              [](const auto& v, const Vec2<T>& u) { return sample_polygon_solid_angle(v, u); }, spl);
-        });
-        benchmark::RegisterBenchmark(("polygon_projected" + suffix).c_str(), [=](benchmark::State& s) {
-          run<T>(
-              s, scene, [](const auto& g) { return make_polygon_projected_view<T, false>(g); },
-              [](const auto& v, const Vec2<T>& u) { return sample_polygon_projected_solid_angle<T, false>(v, u); },
-              spl);
-        });
-        benchmark::RegisterBenchmark(("polygon_projected_biased" + suffix).c_str(), [=](benchmark::State& s) {
-          run<T>(
-              s, scene, [](const auto& g) { return make_polygon_projected_view<T, true>(g); },
-              [](const auto& v, const Vec2<T>& u) { return sample_polygon_projected_solid_angle<T, true>(v, u, 0); },
-              spl);
-        });
-        benchmark::RegisterBenchmark(("polygon_ltc" + suffix).c_str(), [=](benchmark::State& s) {
-          Mat3<T> m;
-          m << T(0.4115), T(-0.1846), T(-0.4395), T(0.0704), T(0.8373), T(-0.1615), T(0), T(0), T(1);
-          run<T>(
-              s, scene,
-              [m](const auto& g) {
-                return make_ltc_polygon_view(LtcPolygonGeometry<T>{g, m});
-              },
-              [](const auto& v, const Vec2<T>& u) { return sample_ltc_polygon(v, u); }, spl);
-        });
-        benchmark::RegisterBenchmark(("polygon_arvo" + suffix).c_str(), [=](benchmark::State& s) {
-          run<T>(
-              s, scene, [](const auto& g) { return make_arvo_fan_view(g); },
-              [](const auto& v, const Vec2<T>& u) { return sample_arvo_triangle_fan(v, u); }, spl);
-        });
-        benchmark::RegisterBenchmark(("polygon_turk_area" + suffix).c_str(), [=](benchmark::State& s) {
-          run<T>(
-              s, scene, [](const auto& g) { return make_turk_area_view(g); },
-              [](const auto& v, const Vec2<T>& u) { return sample_turk_area(v, u); }, spl);
-        });
-        if (n == 4)
-          benchmark::RegisterBenchmark(("spherical_rectangle" + suffix).c_str(), [=](benchmark::State& s) {
-            run<T>(
-                s, scene, [](const auto& g) { return make_spherical_rectangle_view(g); },
-                [](const auto& v, const Vec2<T>& u) { return sample_spherical_rectangle(v, u); }, spl);
+  return out;
+}
+template <class T> std::vector<Scene<PolygonLightGeometry<T>>> scenes(const PolygonLightGeometry<T>*) {
+  std::vector<Scene<PolygonLightGeometry<T>>> out;
+  for (bool central : {true, false})
+    for (int n : {3, 4, 5})
+      out.push_back({(central ? "central-" : "decentral-") + std::to_string(n), polygon_scene<T>(n, central), n});
+  return out;
+}
+
+// The scenes' light of each kernel geometry, and the kernel's geometry from it (see the top).
+template <class G> struct SceneLight { using type = G; };
+template <class T> struct SceneLight<SptdCapGeometry<T>> { using type = SphereLightGeometry<T>; };
+template <class T> struct SceneLight<LtcPolygonGeometry<T>> { using type = PolygonLightGeometry<T>; };
+template <class G> G from_light(const G& g, const G*) { return g; }
+template <class T> SptdCapGeometry<T> from_light(const SphereLightGeometry<T>& g, const SptdCapGeometry<T>*) {
+  SptdCapGeometry<T> c;
+  c.sptd.pivot = Vec3<T>(T(0.2), T(0.1), T(0.5));
+  c.cap = make_sphere_view(g).cap();
+  return c;
+}
+template <class T> LtcPolygonGeometry<T> from_light(const PolygonLightGeometry<T>& g, const LtcPolygonGeometry<T>*) {
+  Mat3<T> m;
+  m << T(0.4115), T(-0.1846), T(-0.4395), T(0.0704), T(0.8373), T(-0.1615), T(0), T(0), T(1);
+  return LtcPolygonGeometry<T>{g, m};
+}
+
+template <class T, class Light> std::string name(const char* kernel, const Scene<Light>& scene, int spl) {
+  return std::string(kernel) + "/" + (std::is_same_v<T, float> ? "float" : "double") + "/" + scene.config +
+         "/spl=" + std::to_string(spl);
+}
+
+// Kernel K on every scene of its geometry, in both modes.
+template <template <class> class K, class T> void register_kernel() {
+  using G = typename K<T>::Geometry;
+  using Light = typename SceneLight<G>::type;
+  for (const Scene<Light>& scene : scenes(static_cast<const Light*>(nullptr))) {
+    if (kernel_takes_only_rectangles<K<T>>() && scene.vertices != 4) continue;
+    for (int spl : {1, kManySamples})
+      benchmark::RegisterBenchmark(
+          name<T>(K<T>::name, scene, spl).c_str(), [spl, l = scene.lights](benchmark::State& s) {
+            run<K, T>(
+                s, l, [](const Light& light) { return from_light(light, static_cast<const G*>(nullptr)); }, spl);
           });
-      }
-    }
   }
+}
+
+// The baselines of every scene, and the batch API.
+template <class T, class Light> void register_baselines() {
+  for (const Scene<Light>& scene : scenes(static_cast<const Light*>(nullptr))) {
+    for (int spl : {1, kManySamples})
+      benchmark::RegisterBenchmark(name<T>("baseline", scene, spl).c_str(),
+                                   [spl, l = scene.lights](benchmark::State& s) { run_baseline<T>(s, l, spl); });
+    if constexpr (std::is_same_v<Light, SphereLightGeometry<T>>)
+      benchmark::RegisterBenchmark((name<T>(SphereSolidAngle<T>::name, scene, kManySamples) + "/batch").c_str(),
+                                   [l = scene.lights](benchmark::State& s) { run_batch<T>(s, l); });
+  }
+}
+
+template <class T> void register_all() {
+  register_baselines<T, SphereLightGeometry<T>>();
+  register_baselines<T, PolygonLightGeometry<T>>();
+  AllKernels::for_each([]<template <class> class K>() { register_kernel<K, T>(); });
 }
 
 }  // namespace

@@ -9,7 +9,7 @@
 namespace warpcheck::validation {
 namespace {
 
-// The "near" geometry of registry_sphere.cpp.
+// The "near" geometry of sphere.cpp.
 SphereView<double> near_view() {
   const SphereLightGeometry<double> g{ShadingPoint<double>{Vec3<double>(0, 0, 0), Vec3<double>(0.2, -0.1, 1)},
                                       SphereLight<double>{Vec3<double>(0.3, 0.2, 1.6), 1.0}};

@@ -1,44 +1,16 @@
-// Polygon-light kernels (Peters 2021 and the published baselines) and their named configurations.
+// Polygon-light kernels (catalogue.h's PolygonKernels: Peters 2021 and the published baselines) and their named
+// configurations.
 #include <algorithm>
 #include <cmath>
-#include <functional>
+#include <string_view>
 #include <utility>
 #include <vector>
 
-#include "warpcheck/polygon_projected.h"
-#include "warpcheck/polygon_solid_angle.h"
-#include "warpcheck/spherical_rectangle.h"
+#include "warpcheck/catalogue.h"
 #include "warpcheck/validation/registry.h"
 
 namespace warpcheck::validation {
 namespace {
-
-// Bounding caps: the support's vertices (clipped where the kernel clips) as directions from the shading point.
-template <class T> Cap<T> cap_of_fan(const PolygonFanView<T>& f) {
-  return bounding_cap_of_directions(f.p.data(), f.count);
-}
-template <class T> Cap<T> cap_of_projected(const PolygonProjectedView<T>& v) {
-  std::array<Vec3<T>, kMaxClippedVertices> w;
-  for (int i = 0; i < v.clipped.count; ++i) w[i] = v.to_world(v.clipped.v[i]);
-  return bounding_cap_of_directions(w.data(), v.clipped.count);
-}
-template <class T> Cap<T> cap_of_polygon(const PolygonLightGeometry<T>& g) {
-  std::array<Vec3<T>, kMaxPolygonVertices> w;
-  for (int i = 0; i < g.light.count; ++i) w[i] = g.light.vertices[i] - g.shading.position;
-  return bounding_cap_of_directions(w.data(), g.light.count);
-}
-
-// Unit normals of the planes through x and each edge (degenerate edges skipped).
-std::vector<Vec3L> edge_planes(const PolygonLightGeometry<Real>& g) {
-  std::vector<Vec3L> planes;
-  const int n = g.light.count;
-  for (int i = 0; i < n; ++i) {
-    const Vec3L e =
-        (g.light.vertices[i] - g.shading.position).cross(g.light.vertices[(i + 1) % n] - g.shading.position);
-    if (e.norm() > 0) planes.push_back(e.normalized());
-  }
-  return planes;
-}
 
 // The angular width of the polygon seen from x: for a convex spherical polygon, the smallest over its edges of
 // the largest angular distance of a vertex from the edge's great circle (a polygon seen 0.3 deg from its plane:
@@ -55,154 +27,27 @@ Real angular_width(const PolygonLightGeometry<Real>& g, const std::vector<Vec3L>
   return width;
 }
 
-// Kinks of a warp that picks a piece (fan triangle, sector) by xi_0 in proportion to `area`: the warp is
-// only piecewise smooth in xi_0 (the solid-angle fan is even discontinuous there: the arc of triangle k ends on
-// v_{k+1}, that of triangle k+1 starts from it), so the battery's finite-difference Jacobian must not straddle
-// the cumulative fractions sum_{i<=k} A_i / A_total. Computed from the long double view, as the reference warp.
-template <class It> std::vector<Real> cumulative_fractions(It first, It last) {
-  Real total = 0;
-  for (It i = first; i != last; ++i) total += Real(*i);
-  std::vector<Real> k;
-  Real sum = 0;
-  if (!(total > 0)) return k;
-  for (It i = first; i != last; ++i) {
-    sum += Real(*i);
-    if (Real(*i) > 0 && sum < total) k.push_back(sum / total);
-  }
-  return k;
+// What each kernel's normaliser measures (its independent reference: polygon.h's long double references, the
+// shoelace area).
+enum class Measure { kProjected, kSolid, kSolidClipped, kArea };
+struct PolygonKernelMeasure {
+  std::string_view kernel;
+  Measure measure;
+};
+constexpr PolygonKernelMeasure kMeasures[] = {
+    {"polygon-projected-solid-angle", Measure::kProjected},
+    {"polygon-projected-solid-angle-biased", Measure::kProjected},
+    {"polygon-solid-angle", Measure::kSolid},
+    {"polygon-solid-angle-clipped", Measure::kSolidClipped},
+    {"baseline-arvo-triangle", Measure::kSolid},
+    {"baseline-turk-area", Measure::kArea},
+    {"baseline-urena-rectangle", Measure::kSolid},
+};
+constexpr const PolygonKernelMeasure* measure_of(std::string_view kernel) {
+  for (const PolygonKernelMeasure& m : kMeasures)
+    if (m.kernel == kernel) return &m;
+  return nullptr;
 }
-template <class T, bool kBiased> std::vector<Real> projected_kinks(const PolygonLightGeometry<T>& g) {
-  const auto v = make_polygon_projected_view<T, kBiased>(g);
-  std::vector<T> a;
-  for (int k = 0; k < v.sector_count; ++k) a.push_back(v.sectors[k].area);
-  return cumulative_fractions(a.begin(), a.end());
-}
-template <class T, class View> std::vector<Real> fan_kinks(const View& v) {
-  return v.valid() ? cumulative_fractions(v.area.begin() + 1, v.area.begin() + std::max(1, v.fan.count - 1))
-                   : std::vector<Real>{};
-}
-
-template <class T> struct ProjectedKernel {
-  // The density with the per-light precomputation done once (the battery's quadrature calls it millions of times).
-  static std::function<Real(const Vec3L&)> cached_pdf(const PolygonLightGeometry<T>& g) {
-    return [v = make_polygon_projected_view<T>(g)](const Vec3L& wl) {
-      const Vec3<T> w = wl.template cast<T>();
-      return Real(pdf_polygon_projected_solid_angle(v, w));
-    };
-  }
-  using Scalar = T;
-  using Geometry = PolygonLightGeometry<T>;
-  static DirectionSample<T> sample(const Geometry& g, const Vec2<T>& u) {
-    return sample_polygon_projected_solid_angle(g, u);
-  }
-  static T pdf(const Geometry& g, const Vec3<T>& w) { return pdf_polygon_projected_solid_angle(g, w); }
-  static Cap<T> bounding_cap(const Geometry& g) {
-    const auto v = make_polygon_projected_view<T>(g);
-    return v.valid() ? cap_of_projected(v) : cap_of_polygon(g);
-  }
-  static T normaliser(const Geometry& g) { return make_polygon_projected_view<T>(g).projected_solid_angle; }
-  static std::vector<Real> kinks_u0(const Geometry& g) { return projected_kinks<T, false>(g); }
-};
-
-template <class T> struct BiasedKernel {
-  // The density with the per-light precomputation done once (the battery's quadrature calls it millions of times).
-  static std::function<Real(const Vec3L&)> cached_pdf(const PolygonLightGeometry<T>& g) {
-    return [v = make_polygon_projected_view<T, true>(g)](const Vec3L& wl) {
-      const Vec3<T> w = wl.template cast<T>();
-      return Real(pdf_polygon_projected_solid_angle(v, w));
-    };
-  }
-  using Scalar = T;
-  using Geometry = PolygonLightGeometry<T>;
-  static DirectionSample<T> sample(const Geometry& g, const Vec2<T>& u) {
-    return sample_polygon_projected_solid_angle_biased(g, u);
-  }
-  static T pdf(const Geometry& g, const Vec3<T>& w) { return pdf_polygon_projected_solid_angle_biased(g, w); }
-  static Cap<T> bounding_cap(const Geometry& g) { return ProjectedKernel<T>::bounding_cap(g); }
-  static T normaliser(const Geometry& g) { return make_polygon_projected_view<T, true>(g).projected_solid_angle; }
-  static std::vector<Real> kinks_u0(const Geometry& g) { return projected_kinks<T, true>(g); }
-};
-
-template <class T, bool kClipped> struct SolidAngleKernel {
-  // The density with the per-light precomputation done once (the battery's quadrature calls it millions of times).
-  static std::function<Real(const Vec3L&)> cached_pdf(const PolygonLightGeometry<T>& g) {
-    return [v = make_polygon_solid_angle_view(g, kClipped)](const Vec3L& wl) {
-      const Vec3<T> w = wl.template cast<T>();
-      return Real(pdf_polygon_solid_angle(v, w));
-    };
-  }
-  using Scalar = T;
-  using Geometry = PolygonLightGeometry<T>;
-  static DirectionSample<T> sample(const Geometry& g, const Vec2<T>& u) {
-    return sample_polygon_solid_angle(g, u, kClipped);
-  }
-  static T pdf(const Geometry& g, const Vec3<T>& w) { return pdf_polygon_solid_angle(g, w, kClipped); }
-  static Cap<T> bounding_cap(const Geometry& g) {
-    const auto f = make_polygon_fan_view(g, kClipped);
-    return f.valid() ? cap_of_fan(f) : cap_of_polygon(g);
-  }
-  static T normaliser(const Geometry& g) { return make_polygon_solid_angle_view(g, kClipped).solid_angle; }
-  static std::vector<Real> kinks_u0(const Geometry& g) {
-    return fan_kinks<T>(make_polygon_solid_angle_view(g, kClipped));
-  }
-};
-template <class T> using SolidAngleUnclipped = SolidAngleKernel<T, false>;
-template <class T> using SolidAngleClipped = SolidAngleKernel<T, true>;
-
-template <class T> struct ArvoKernel {
-  // The density with the per-light precomputation done once (the battery's quadrature calls it millions of times).
-  static std::function<Real(const Vec3L&)> cached_pdf(const PolygonLightGeometry<T>& g) {
-    return [v = make_arvo_fan_view(g)](const Vec3L& wl) {
-      const Vec3<T> w = wl.template cast<T>();
-      return Real((v.valid() && all_finite(w) && in_fan_cone(v.fan, w) ? T(1) / v.solid_angle : T(0)));
-    };
-  }
-  using Scalar = T;
-  using Geometry = PolygonLightGeometry<T>;
-  static DirectionSample<T> sample(const Geometry& g, const Vec2<T>& u) { return sample_arvo_triangle_fan(g, u); }
-  static T pdf(const Geometry& g, const Vec3<T>& w) { return pdf_arvo_triangle_fan(g, w); }
-  static Cap<T> bounding_cap(const Geometry& g) { return SolidAngleKernel<T, false>::bounding_cap(g); }
-  static T normaliser(const Geometry& g) { return make_arvo_fan_view(g).solid_angle; }
-  static std::vector<Real> kinks_u0(const Geometry& g) { return fan_kinks<T>(make_arvo_fan_view(g)); }
-};
-
-template <class T> struct TurkKernel {
-  // The density with the per-light precomputation done once (the battery's quadrature calls it millions of times).
-  static std::function<Real(const Vec3L&)> cached_pdf(const PolygonLightGeometry<T>& g) {
-    return [v = make_turk_area_view(g)](const Vec3L& wl) {
-      const Vec3<T> w = wl.template cast<T>();
-      return Real(
-          (v.valid() && all_finite(w) && in_fan_cone(v.fan, w) ? turk_density(v, Vec3<T>(w.normalized())) : T(0)));
-    };
-  }
-  using Scalar = T;
-  using Geometry = PolygonLightGeometry<T>;
-  static DirectionSample<T> sample(const Geometry& g, const Vec2<T>& u) { return sample_turk_area(g, u); }
-  static T pdf(const Geometry& g, const Vec3<T>& w) { return pdf_turk_area(g, w); }
-  static Cap<T> bounding_cap(const Geometry& g) { return SolidAngleKernel<T, false>::bounding_cap(g); }
-  static T normaliser(const Geometry& g) { return make_turk_area_view(g).total_area; }
-  static std::vector<Real> kinks_u0(const Geometry& g) { return fan_kinks<T>(make_turk_area_view(g)); }
-};
-
-template <class T> struct UrenaKernel {
-  // The density with the per-light precomputation done once (the battery's quadrature calls it millions of times).
-  static std::function<Real(const Vec3L&)> cached_pdf(const PolygonLightGeometry<T>& g) {
-    return [v = make_spherical_rectangle_view(g)](const Vec3L& wl) {
-      const Vec3<T> w = wl.template cast<T>();
-      return Real(pdf_spherical_rectangle(v, w));
-    };
-  }
-  using Scalar = T;
-  using Geometry = PolygonLightGeometry<T>;
-  static DirectionSample<T> sample(const Geometry& g, const Vec2<T>& u) { return sample_spherical_rectangle(g, u); }
-  static T pdf(const Geometry& g, const Vec3<T>& w) { return pdf_spherical_rectangle(g, w); }
-  static Cap<T> bounding_cap(const Geometry& g) { return SolidAngleKernel<T, false>::bounding_cap(g); }
-  static T normaliser(const Geometry& g) { return make_spherical_rectangle_view(g).solid_angle; }
-  static std::vector<Real> kinks_u0(const Geometry&) { return {}; }  // one smooth warp (Urena et al. 2013 Sec. 4)
-};
-
-// What each kernel's normaliser is and its independent reference.
-enum class Measure { kProjected, kSolid, kSolidClipped, kArea, kNone };
 
 using G = PolygonLightGeometry<Real>;
 
@@ -285,7 +130,7 @@ std::vector<PolygonConfig> configs() {
 //    1e7): chi2 and KS p < 1e-45 for every kernel, pdf-consistency 1 (a sample's direction outside the light).
 //    Peters 2021 Sec. 3.7 recommends area sampling here; in float that is no cure either.
 //  * Arvo 1995 and Urena et al. 2013 in float on nearly-edge-on: normalisers off by 2.6e-4 and 3.8e-3 (the same
-//    cancellation; float battery at 1e7 samples, 2026-12-02).
+//    cancellation; float battery at 1e7 samples).
 //  * Arvo 1995 and Urena et al. 2013 in float on both far lights: their solid angles (angle sums minus pi resp.
 //    2 pi) cancel: 1 cm, 0 (Arvo: no samples) and -2.4e-7 (Urena) for 5.3e-8 sr; 1 mm, 0 and 2.4e-7 for 5.3e-10.
 const char* polygon_known_limitation(const std::string& kernel, const std::string& scalar, const std::string& config) {
@@ -320,94 +165,81 @@ const char* polygon_known_limitation(const std::string& kernel, const std::strin
   return "";
 }
 
-template <template <class> class K, class T>
-void add_case(Registry& r, const char* kernel, const PolygonConfig& c, Measure measure) {
+Normalization reference_normalization(Measure measure, const G& g) {
+  Normalization n;
+  switch (measure) {
+    case Measure::kProjected:
+      n.what = "projected solid angle (Lambert)", n.reference = reference_projected_solid_angle(g);
+      break;
+    case Measure::kSolid:
+      n.what = "solid angle (van Oosterom-Strackee)", n.reference = reference_solid_angle(g);
+      break;
+    case Measure::kSolidClipped:
+      n.what = "clipped solid angle (van Oosterom-Strackee)", n.reference = reference_solid_angle(g, true);
+      break;
+    case Measure::kArea: {
+      n.what = "polygon area (shoelace in long double)";
+      Vec3L a = Vec3L::Zero();
+      for (int i = 0; i < g.light.count; ++i) a += g.light.vertices[i].cross(g.light.vertices[(i + 1) % g.light.count]);
+      n.reference = a.norm() / 2;
+      break;
+    }
+  }
+  return n;
+}
+
+// Input rounding alone perturbs a light of size s at distance d by ~eps d / s relative (see test_polygon.cpp's
+// normalisation tolerance); 64 eps (1 + d / s), stated a priori.
+Real float_tolerance(const G& g) {
+  Real d = 0, size = 0;
+  for (int i = 0; i < g.light.count; ++i) {
+    d = std::max(d, (g.light.vertices[i] - g.shading.position).norm());
+    for (int j = 0; j < g.light.count; ++j) size = std::max(size, (g.light.vertices[i] - g.light.vertices[j]).norm());
+  }
+  return std::max(1e-6L, 64 * Real(std::numeric_limits<float>::epsilon()) * (1 + d / size));
+}
+
+template <template <class> class K, class T> SamplerUnderTest make_sampler(const PolygonConfig& c) {
+  SamplerUnderTest s = bind_kernel<K<T>, K<Real>>(c.name, c.g.template cast<T>(), c.g);
+  s.expect_no_sample = !K<Real>::sample(K<Real>::view(c.g), Vec2<Real>(0.5L, 0.5L)).valid();
+  // Breakpoints only for slivers (thinner than a sixteenth of the bounding cap's radius, the default grid's
+  // ring spacing): they multiply the quadrature's cost (about 4x on central-square), and the default nodes
+  // resolve every other configuration.
+  const Real theta_max = std::acos(std::clamp<Real>(1 - s.bounding_cap.one_minus_cos, -1, 1));
+  if (angular_width(c.g, polygon_edge_planes(c.g)) < theta_max / 16) s.boundary_planes = K<Real>::boundary_planes(c.g);
+  if (s.expect_no_sample) return s;
+  Normalization n = reference_normalization(measure_of(K<T>::name)->measure, c.g);
+  n.kernel = [g = c.g.template cast<T>()] { return Real(K<T>::normaliser(K<T>::view(g))); };
+  s.normalizations.push_back(n);
+  if constexpr (std::is_same_v<T, float>) {
+    s.tolerance = float_tolerance(c.g);
+    s.tolerance_note = "float input rounding: 64 eps (1 + distance / size)";
+  }
+  return s;
+}
+
+template <template <class> class K, class T> void add_case(Registry& r, const PolygonConfig& c) {
   Case k;
-  k.known_limitation = polygon_known_limitation(kernel, scalar_name<T>(), c.name);
-  k.kernel = kernel;
+  k.known_limitation = polygon_known_limitation(K<T>::name, scalar_name<T>(), c.name);
+  k.kernel = K<T>::name;
   k.scalar = scalar_name<T>();
   k.config = c.name;
   k.description = c.description;
-  k.make = [c, kernel, measure] {
-    SamplerUnderTest s = bind_kernel<K<T>, K<Real>>(kernel, c.name, c.g.template cast<T>(), c.g);
-    s.pdf = K<T>::cached_pdf(c.g.template cast<T>());  // same density as K::pdf, without rebuilding the view
-    s.expect_no_sample = !K<Real>::sample(c.g, Vec2<Real>(0.5L, 0.5L)).valid();
-    s.kinks_u0 = K<Real>::kinks_u0(c.g);
-    // Breakpoints only for slivers (thinner than a sixteenth of the bounding cap's radius, the default grid's
-    // ring spacing): they multiply the quadrature's cost (measured on central-square, projected kernel: double,
-    // 1000 samples, 19.9 s -> 78.6 s of CPU), and the default nodes already resolve every other configuration
-    // (the double battery of 9ec2b69 passed them all). In float they cost most in the KS rings, whose lines
-    // barely touching the support ran to their panel budget until ks_cdfs got an absolute tolerance (battery.cpp:
-    // nearly-edge-on float, 1136 s -> 160 s of CPU in the rings).
-    const Real theta_max = std::acos(std::clamp<Real>(1 - s.bounding_cap.one_minus_cos, -1, 1));
-    // The great circles on which the pdfs jump or kink: the edges' planes and the horizon (where the clipped
-    // kernels' supports end and the projected density's cosine reaches 0).
-    std::vector<Vec3L> planes = edge_planes(c.g);
-    if (angular_width(c.g, planes) < theta_max / 16) {
-      if (c.g.shading.normal.norm() > 0) planes.push_back(c.g.shading.normal.normalized());
-      s.boundary_planes = std::move(planes);
-    }
-    if (s.expect_no_sample || measure == Measure::kNone) return s;
-    Normalization n;
-    n.kernel = [g = c.g.template cast<T>()] { return Real(K<T>::normaliser(g)); };
-    switch (measure) {
-      case Measure::kProjected:
-        n.what = "projected solid angle (Lambert)", n.reference = reference_projected_solid_angle(c.g);
-        break;
-      case Measure::kSolid:
-        n.what = "solid angle (van Oosterom-Strackee)", n.reference = reference_solid_angle(c.g);
-        break;
-      case Measure::kSolidClipped:
-        n.what = "clipped solid angle (van Oosterom-Strackee)", n.reference = reference_solid_angle(c.g, true);
-        break;
-      case Measure::kArea: {
-        n.what = "polygon area (shoelace in long double)";
-        Vec3L a = Vec3L::Zero();
-        for (int i = 0; i < c.g.light.count; ++i)
-          a += c.g.light.vertices[i].cross(c.g.light.vertices[(i + 1) % c.g.light.count]);
-        n.reference = a.norm() / 2;
-        break;
-      }
-      case Measure::kNone:
-        break;
-    }
-    s.normalizations.push_back(n);
-    if constexpr (std::is_same_v<T, float>) {
-      // Input rounding alone perturbs a light of size s at distance d by ~eps d / s relative (see
-      // test_polygon.cpp's normalisation tolerance); 64 eps (1 + d / s), stated a priori.
-      Real d = 0, size = 0;
-      for (int i = 0; i < c.g.light.count; ++i) {
-        d = std::max(d, (c.g.light.vertices[i] - c.g.shading.position).norm());
-        for (int j = 0; j < c.g.light.count; ++j)
-          size = std::max(size, (c.g.light.vertices[i] - c.g.light.vertices[j]).norm());
-      }
-      s.tolerance = std::max(1e-6L, 64 * Real(std::numeric_limits<float>::epsilon()) * (1 + d / size));
-      s.tolerance_note = "float input rounding: 64 eps (1 + distance / size)";
-    }
-    return s;
-  };
+  k.make = [c] { return make_sampler<K, T>(c); };
   r.add(std::move(k));
-}
-
-template <template <class> class K>
-void add_all_scalars(Registry& r, const char* kernel, const PolygonConfig& c, Measure m) {
-  add_case<K, float>(r, kernel, c, m);
-  add_case<K, double>(r, kernel, c, m);
-  add_case<K, Real>(r, kernel, c, m);
 }
 
 }  // namespace
 
 void register_polygon_kernels(Registry& r) {
-  for (const PolygonConfig& c : configs()) {
-    add_all_scalars<ProjectedKernel>(r, "polygon-projected-solid-angle", c, Measure::kProjected);
-    add_all_scalars<BiasedKernel>(r, "polygon-projected-solid-angle-biased", c, Measure::kProjected);
-    add_all_scalars<SolidAngleUnclipped>(r, "polygon-solid-angle", c, Measure::kSolid);
-    add_all_scalars<SolidAngleClipped>(r, "polygon-solid-angle-clipped", c, Measure::kSolidClipped);
-    add_all_scalars<ArvoKernel>(r, "baseline-arvo-triangle", c, Measure::kSolid);
-    add_all_scalars<TurkKernel>(r, "baseline-turk-area", c, Measure::kArea);
-    if (c.rectangle) add_all_scalars<UrenaKernel>(r, "baseline-urena-rectangle", c, Measure::kSolid);
-  }
+  for (const PolygonConfig& c : configs())
+    PolygonKernels::for_each([&]<template <class> class K>() {
+      static_assert(measure_of(K<Real>::name), "a polygon kernel without its entry in kMeasures");
+      if (kernel_takes_only_rectangles<K<Real>>() && !c.rectangle) return;
+      add_case<K, float>(r, c);
+      add_case<K, double>(r, c);
+      add_case<K, Real>(r, c);
+    });
   // Known limitations: polygon_known_limitation() above, set per case by add_case.
 }
 

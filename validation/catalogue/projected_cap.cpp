@@ -1,4 +1,5 @@
-// Projected spherical cap sampling (Peters & Dachsbacher 2019) and its named configurations.
+// Projected spherical cap sampling (Peters & Dachsbacher 2019, catalogue.h's ProjectedCapKernels) and its named
+// configurations.
 //
 // Two kernels: "sphere-projected-cap" is the paper's algorithm (the quintic of Alg. 5); "sphere-projected-cap-exact"
 // replaces the quintic by the exact inverse of A(X) (see lib/warpcheck/projected_cap.h). Both report the exact
@@ -10,23 +11,10 @@
 #include <cmath>
 
 #include "catalogue/projected_cap_configs.h"
-#include "warpcheck/projected_cap.h"
+#include "warpcheck/catalogue.h"
 #include "warpcheck/validation/registry.h"
 
 namespace warpcheck::validation {
-
-template <class T, CutDiskInverse M> struct ProjectedCapKernel {
-  using Scalar = T;
-  using Geometry = SphereLightGeometry<T>;
-  static DirectionSample<T> sample(const Geometry& g, const Vec2<T>& u) {
-    return sample_projected_spherical_cap<T, M>(g, u);
-  }
-  static T pdf(const Geometry& g, const Vec3<T>& w) { return pdf_projected_spherical_cap<T, M>(g, w); }
-  static Cap<T> bounding_cap(const Geometry& g) {
-    const auto v = make_projected_cap_view(g);
-    return v.valid() ? projected_cap_bounding_cap(v) : make_sphere_view(g).cap();
-  }
-};
 
 // Integral over phi in [0, 2 pi) of max(0, A + B cos phi)^power, B >= 0, power 1 or 2, in closed form.
 Real ring_integral(Real a, Real b, int power) {
@@ -94,18 +82,16 @@ std::vector<ProjectedCapConfig> projected_cap_configs() {
 }
 
 // float's tolerance per configuration: twice the largest deterministic statistic (pdf-consistency, pdf-integral,
-// normalisations, hit bias) of either float kernel, rounded up to one digit, at least the shared 1e-6. Measured
-// 2026-12-02 at commit ef014ba (the battery evaluating the reference at the float-rounded primary sample) with
-//   warpcheck validate --kernel 'sphere-projected-cap*' --scalar float --threads 2
-// (1e7 samples, 880 s; all 78 chi2/KS tests pass, smallest p 3.8e-4, Holm at 0.01). The measured value is in
-// each comment; what limits it:
+// normalisations, hit bias) of either float kernel, rounded up to one digit, at least the shared 1e-6, measured
+// with
+//   warpcheck validate --kernel 'sphere-projected-cap*' --scalar float
+// (1e7 samples; all 78 chi2/KS tests pass, smallest p 3.8e-4, Holm at 0.01). The measured value is in each
+// comment; what limits it:
 //  * near-touching (d = 1.001 r): cos(theta_max) = sqrt(1 - (r/d)^2) loses ~1e-5 to the cancellation, inherent
 //    in float when d is only known to eps d (see ProjectedCapFloat.SamplePdfsNearTheHorizonKeepTheirDigits);
 //  * near-touching-case3: Case 3's w_x = sqrt(1 - w_y^2 - w_z^2) (pdf(dir) agrees with pdf to 3.8e-5 only);
 //  * tiny (2e-3 rad): pdf-integral 1e-5 low, the float cap's edge is rounded by ~eps / theta_max of its width;
 //  * case3-sliver: the lune is 1% of the radius high, its heights a few eps_float wide.
-// Before a43fe14 (heights, left-areas and right-areas with cancellation) the deterministic checks measured 1.2e-5
-// to 3.1e-3 and tiny-straddling failed outright (pdf-integral 0.959, chi2 statistic 4e5).
 Real projected_cap_float_tolerance(const std::string& config) {
   struct Entry {
     const char* config;
@@ -139,43 +125,11 @@ template <class T> SphereLightGeometry<T> cast(const SphereLightGeometry<Real>& 
 
 }  // namespace
 
-// Kinks in u0 of the warp (see the header comment of projected_cap.h): the Case-2 threshold tau, where the warp
-// passes from the ellipse piece to the mirrored disk (continuous there, but its derivative jumps), and for the
-// quintic the u0 where a piece's left-area passes pi/2: the rescaled quintic's halves meet there with equal
-// slopes, but its density factor depends on min(a, pi - a) and has a kink (tanh-sinh quadrature across it was
-// 2.2e-5 off on the tiny-straddling ellipse piece). With the pieces matched to the cuts neither inverse reaches
-// a direction twice, so there are no bands of double coverage; the function keeps returning (a, b) pairs,
-// a == b for a single kink.
+// The kernel's kinks in u0 (its catalogue trait) as (a, a) pairs.
 template <CutDiskInverse M> std::vector<std::pair<Real, Real>> projected_cap_bands(const SphereLightGeometry<Real>& g) {
-  using namespace projected_cap_detail;
   std::vector<std::pair<Real, Real>> bands;
-  const ProjectedCapView<Real> p = make_projected_cap_view(g);
-  if (!p.valid()) return bands;
-  if (p.which_case == 2) bands.push_back({p.tau, p.tau});
-  if constexpr (M == CutDiskInverse::kQuintic) {
-    std::array<Piece<Real>, 2> ps;
-    const int n = pieces<Real, M>(p, ps);
-    for (int i = 0; i < n; ++i) {
-      const Real u = (kPi<Real> / 2 - ps[i].alpha) / ps[i].beta;
-      if (u > ps[i].u_lo && u < ps[i].u_hi) bands.push_back({u, u});
-    }
-  }
-  std::sort(bands.begin(), bands.end());
+  for (Real u : SphereProjectedCapKernel<Real, M>::kinks_u0(g)) bands.push_back({u, u});
   return bands;
-}
-
-template <CutDiskInverse M> std::vector<Real> projected_cap_kinks(const SphereLightGeometry<Real>& g) {
-  std::vector<Real> kinks;
-  for (const auto& [a, b] : projected_cap_bands<M>(g)) {
-    if (a == b) {
-      kinks.push_back(a);
-      continue;
-    }
-    const Real lo = std::max<Real>(0, a - 1e-5L), hi = std::min<Real>(1, b + 1e-5L);
-    const int count = int(std::min<Real>(2e5L, std::ceil((hi - lo) / 4e-6L)));
-    for (int k = 0; k <= count; ++k) kinks.push_back(lo + (hi - lo) * Real(k) / Real(std::max(count, 1)));
-  }
-  return kinks;
 }
 
 // Moments of the Lambertian irradiance estimator X = cos / pdf (unit radiance) over primary sample space, on the
@@ -234,29 +188,24 @@ LambertianMoments projected_cap_lambertian_moments(const SphereLightGeometry<Rea
 
 namespace {
 
-template <class T, CutDiskInverse M> Case make_case(const char* kernel, const ProjectedCapConfig& c) {
+template <template <class> class K, class T> Case make_case(const ProjectedCapConfig& c) {
+  constexpr CutDiskInverse M = K<T>::inverse;
+  const char* kernel = K<T>::name;
   Case k;
   k.kernel = kernel;
   k.scalar = scalar_name<T>();
   k.config = c.name;
   k.description = c.description;
-  using K = ProjectedCapKernel<T, M>;
-  using KR = ProjectedCapKernel<Real, M>;
-  k.make = [c, kernel] {
-    SamplerUnderTest s = bind_kernel<K, KR>(kernel, c.name, cast<T>(c.g), c.g);
-    // The density with the per-light precomputation done once (the quadratures call it millions of times).
-    s.pdf = [v = make_projected_cap_view(cast<T>(c.g))](const Vec3L& w) {
-      return Real(pdf_projected_spherical_cap<T, M>(v, w.template cast<T>()));
-    };
-    const ProjectedCapView<Real> pr = make_projected_cap_view(c.g);
+  k.make = [c] {
+    SamplerUnderTest s = bind_kernel<K<T>, K<Real>>(c.name, cast<T>(c.g), c.g);
+    const ProjectedCapView<Real> pr = K<Real>::view(c.g);
     s.expect_no_sample = !pr.valid();
     if (s.expect_no_sample) return s;
-    s.kinks_u0 = projected_cap_kinks<M>(c.g);
     const Real reference = reference_projected_solid_angle(c.g);
     if (pr.which_case <= 2) {
       Normalization nz;
       nz.what = "A_E + A_D vs projected solid angle (quadrature of cos over the cap)";
-      nz.kernel = [g = cast<T>(c.g)] { return Real(make_projected_cap_view(g).total); };
+      nz.kernel = [g = cast<T>(c.g)] { return Real(K<T>::normaliser(K<T>::view(g))); };
       nz.reference = reference;
       s.normalizations.push_back(nz);
     }
@@ -318,12 +267,6 @@ template <class T, CutDiskInverse M> Case make_case(const char* kernel, const Pr
   return k;
 }
 
-template <CutDiskInverse M> void add_all(Registry& r, const char* kernel, const ProjectedCapConfig& c) {
-  r.add(make_case<float, M>(kernel, c));
-  r.add(make_case<double, M>(kernel, c));
-  r.add(make_case<Real, M>(kernel, c));
-}
-
 }  // namespace
 
 template LambertianMoments projected_cap_lambertian_moments<float, CutDiskInverse::kQuintic>(
@@ -338,18 +281,18 @@ template LambertianMoments projected_cap_lambertian_moments<double, CutDiskInver
     const SphereLightGeometry<Real>&, Real);
 template LambertianMoments projected_cap_lambertian_moments<Real, CutDiskInverse::kExact>(
     const SphereLightGeometry<Real>&, Real);
-template std::vector<Real> projected_cap_kinks<CutDiskInverse::kQuintic>(const SphereLightGeometry<Real>&);
-template std::vector<Real> projected_cap_kinks<CutDiskInverse::kExact>(const SphereLightGeometry<Real>&);
 template std::vector<std::pair<Real, Real>> projected_cap_bands<CutDiskInverse::kQuintic>(
     const SphereLightGeometry<Real>&);
 template std::vector<std::pair<Real, Real>> projected_cap_bands<CutDiskInverse::kExact>(
     const SphereLightGeometry<Real>&);
 
 void register_projected_cap_kernels(Registry& r) {
-  for (const ProjectedCapConfig& c : projected_cap_configs()) {
-    add_all<CutDiskInverse::kQuintic>(r, "sphere-projected-cap", c);
-    add_all<CutDiskInverse::kExact>(r, "sphere-projected-cap-exact", c);
-  }
+  for (const ProjectedCapConfig& c : projected_cap_configs())
+    ProjectedCapKernels::for_each([&]<template <class> class K>() {
+      r.add(make_case<K, float>(c));
+      r.add(make_case<K, double>(c));
+      r.add(make_case<K, Real>(c));
+    });
 }
 
 }  // namespace warpcheck::validation

@@ -17,18 +17,15 @@ struct ProjectedCapConfig {
   SphereLightGeometry<Real> g;
 };
 
-// Cases 1-4, their boundaries, grazing, near-touching, tiny and huge lights
-// (validation/src/registry_projected_cap.cpp).
+// Cases 1-4, their boundaries, grazing, near-touching, tiny and huge lights (projected_cap.cpp).
 std::vector<ProjectedCapConfig> projected_cap_configs();
 
 // Projected solid angle of the light by long double adaptive quadrature of max(0, n.w) over its cap:
 // independent of the kernel's A_E + A_D code path.
 Real reference_projected_solid_angle(const SphereLightGeometry<Real>& g, Real tol = 1e-12L);
 
-// Kinks of the warp in u0 (threshold, and the quintic's multiply-covered bands listed densely).
-template <CutDiskInverse M> std::vector<Real> projected_cap_kinks(const SphereLightGeometry<Real>& g);
-// The u0 intervals behind those kinks: (tau, tau) for the Case-2 threshold, and (lo, hi) for each band where
-// the quintic's warp reaches directions twice (fold, seam).
+// The kernel's kinks in u0 (its catalogue trait: the Case-2 threshold tau, the quintic's left-area pi/2) as
+// intervals (u, u), where the quadratures over primary sample space split.
 template <CutDiskInverse M> std::vector<std::pair<Real, Real>> projected_cap_bands(const SphereLightGeometry<Real>& g);
 // Integral of max(0, n.w)^power (power 1: the projected solid angle) over the light's cap, by rings around the
 // cap's axis in closed form and long double Gauss-Kronrod across the rings.
@@ -44,7 +41,7 @@ template <class T, CutDiskInverse M>
 LambertianMoments projected_cap_lambertian_moments(const SphereLightGeometry<Real>& g, Real tol = 1e-10L);
 
 // float's tolerance for a configuration: twice its measured float error (the largest deterministic battery
-// statistic of the float kernels, see registry_projected_cap.cpp), rounded up to one digit, at least 1e-6.
+// statistic of the float kernels, see projected_cap.cpp), rounded up to one digit, at least 1e-6.
 Real projected_cap_float_tolerance(const std::string& config);
 
 }  // namespace warpcheck::validation

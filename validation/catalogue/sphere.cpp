@@ -1,25 +1,11 @@
-// Sphere-light kernels and their named configurations.
-#include "warpcheck/sphere.h"
+// Sphere-light kernels (catalogue.h's SphereKernels) and their named configurations.
+#include <string_view>
+
+#include "warpcheck/catalogue.h"
 #include "warpcheck/validation/registry.h"
 
 namespace warpcheck::validation {
 namespace {
-
-template <class T> struct SphereSolidAngle {
-  using Scalar = T;
-  using Geometry = SphereLightGeometry<T>;
-  static DirectionSample<T> sample(const Geometry& g, const Vec2<T>& u) { return sample_sphere_solid_angle(g, u); }
-  static T pdf(const Geometry& g, const Vec3<T>& w) { return pdf_sphere_solid_angle(g, w); }
-  static Cap<T> bounding_cap(const Geometry& g) { return make_sphere_view(g).cap(); }
-};
-
-template <class T> struct SphereVisibleArea {
-  using Scalar = T;
-  using Geometry = SphereLightGeometry<T>;
-  static DirectionSample<T> sample(const Geometry& g, const Vec2<T>& u) { return sample_sphere_visible_area(g, u); }
-  static T pdf(const Geometry& g, const Vec3<T>& w) { return pdf_sphere_visible_area(g, w); }
-  static Cap<T> bounding_cap(const Geometry& g) { return make_sphere_view(g).cap(); }
-};
 
 struct SphereConfig {
   const char* name;
@@ -74,24 +60,64 @@ const SphereConfig kConfigs[] = {
 // ~sqrt(eps |f|^2 / r^2) of a density ~1/sqrt(disc) (sqrt(FLT_EPSILON) = 3.5e-4): the measured errors. No
 // reformulation removes it in float (the silhouette is defined by that difference); a renderer that needs it
 // evaluates disc in double. Double and long double pass.
-const char* const kVisibleAreaFloat =
+constexpr const char* kVisibleAreaFloat =
     "float visible-area sampling: the density ~1/cos_light is wrong by O(1) within ~eps|f|^2 of the silhouette "
     "(disc = r^2 - |f_perp|^2 cancels), a band of mass ~sqrt(FLT_EPSILON) = 3.5e-4; measured pdf-integral 3.1e-4 "
     "(near) to 5.7e-4 (far) at 1e7 samples; see registry_sphere.cpp";
 
-template <template <class> class K, class T> void add_case(Registry& r, const char* kernel, const SphereConfig& c,
-                                                           Normalization (*norm)(const SphereConfig&),
-                                                           const char* known_limitation = "") {
+// The normalisation check of each sphere kernel: what its normaliser measures, and the independent reference.
+struct SphereKernelCheck {
+  std::string_view kernel;
+  const char* what;
+  Real (*reference)(const SphereLightGeometry<Real>&);
+  const char* float_limitation;  // Case::known_limitation of the float cases
+};
+constexpr SphereKernelCheck kChecks[] = {
+    {"sphere-solid-angle", "cone solid angle", reference_solid_angle, ""},
+    {"sphere-visible-area", "visible cap area", reference_visible_area, kVisibleAreaFloat},
+};
+constexpr const SphereKernelCheck* check_of(std::string_view kernel) {
+  for (const SphereKernelCheck& c : kChecks)
+    if (c.kernel == kernel) return &c;
+  return nullptr;
+}
+
+// The visible-area kernel's normaliser, read off a sample: pdf = dist^2 / (cos_light A), so
+// A = dist^2 / (cos_light pdf), with dist and cos_light recomputed from the sampled direction.
+template <template <class> class K, class T> Real normaliser_from_a_sample(const SphereLightGeometry<Real>& g) {
+  // The sample (direction and pdf) in T; the geometry of the ray in long double.
+  const Sample s = to_sample(K<T>::sample(K<T>::view(cast<T>(g)), Vec2<T>(T(0.37L), T(0.61L))));
+  const Vec3L f = g.shading.position - g.light.center;
+  const Real b = f.dot(s.direction), disc = g.light.radius * g.light.radius - (f - b * s.direction).squaredNorm();
+  const Real t = -b - std::sqrt(disc), cos_light = std::sqrt(disc) / g.light.radius;
+  return t * t / (cos_light * s.pdf);
+}
+
+// The kernel's side of the check: its normaliser, or for a kernel whose density never forms one (visible area)
+// the normaliser its pdf implies at a sample.
+template <template <class> class K, class T> Normalization normalization(const SphereConfig& c) {
+  Normalization n;
+  n.what = check_of(K<T>::name)->what;
+  if constexpr (requires(const typename K<T>::View& v) { K<T>::normaliser(v); })
+    n.kernel = [g = cast<T>(c.g)] { return Real(K<T>::normaliser(K<T>::view(g))); };
+  else
+    n.kernel = [g = c.g] { return normaliser_from_a_sample<K, T>(g); };
+  n.reference = check_of(K<T>::name)->reference(c.g);
+  return n;
+}
+
+template <template <class> class K, class T> void add_case(Registry& r, const SphereConfig& c) {
   Case k;
-  k.known_limitation = make_sphere_view(c.g).valid() ? known_limitation : "";  // no-sample cases pass
-  k.kernel = kernel;
+  const bool valid = make_sphere_view(c.g).valid();
+  k.known_limitation = valid && std::is_same_v<T, float> ? check_of(K<T>::name)->float_limitation : "";
+  k.kernel = K<T>::name;
   k.scalar = scalar_name<T>();
   k.config = c.name;
   k.description = c.description;
-  k.make = [c, kernel, norm] {
-    SamplerUnderTest s = bind_kernel<K<T>, K<Real>>(kernel, c.name, cast<T>(c.g), c.g);
-    s.expect_no_sample = !make_sphere_view(c.g).valid();
-    if (!s.expect_no_sample) s.normalizations.push_back(norm(c));
+  k.make = [c, valid] {
+    SamplerUnderTest s = bind_kernel<K<T>, K<Real>>(c.name, cast<T>(c.g), c.g);
+    s.expect_no_sample = !valid;
+    if (valid) s.normalizations.push_back(normalization<K, T>(c));
     if constexpr (std::is_same_v<T, float>) {
       // Measured, not derived: at 1e7 samples (seed 1) the float solid-angle kernel's pdf integrates to 1 - 5.2e-6 on
       // "tiny" (cap half-angle 2e-3 rad, 1 - cos = 2e-6, a few float ulps of 1); the others stay below 1e-6. The
@@ -104,43 +130,16 @@ template <template <class> class K, class T> void add_case(Registry& r, const ch
   r.add(std::move(k));
 }
 
-template <class T> Normalization solid_angle_norm(const SphereConfig& c) {
-  Normalization n;
-  n.what = "cone solid angle";
-  n.kernel = [g = cast<T>(c.g)] { return Real(1 / sphere_solid_angle_density(make_sphere_view(g))); };
-  n.reference = reference_solid_angle(c.g);
-  return n;
-}
-
-// The visible-area kernel's normaliser, read off a sample: pdf = dist^2 / (cos_light A), so
-// A = dist^2 / (cos_light pdf), with dist and cos_light recomputed from the sampled direction.
-template <class T> Normalization visible_area_norm(const SphereConfig& c) {
-  Normalization n;
-  n.what = "visible cap area";
-  n.kernel = [g = c.g, gt = cast<T>(c.g)] {
-    // The sample (direction and pdf) in T; the geometry of the ray in long double.
-    const auto st = sample_sphere_visible_area(gt, Vec2<T>(T(0.37L), T(0.61L)));
-    const Sample s = to_sample(st);
-    const Vec3L f = g.shading.position - g.light.center;
-    const Real b = f.dot(s.direction), disc = g.light.radius * g.light.radius - (f - b * s.direction).squaredNorm();
-    const Real t = -b - std::sqrt(disc), cos_light = std::sqrt(disc) / g.light.radius;
-    return t * t / (cos_light * s.pdf);
-  };
-  n.reference = reference_visible_area(c.g);
-  return n;
-}
-
 }  // namespace
 
 void register_sphere_kernels(Registry& r) {
-  for (const SphereConfig& c : kConfigs) {
-    add_case<SphereSolidAngle, float>(r, "sphere-solid-angle", c, solid_angle_norm<float>);
-    add_case<SphereSolidAngle, double>(r, "sphere-solid-angle", c, solid_angle_norm<double>);
-    add_case<SphereSolidAngle, Real>(r, "sphere-solid-angle", c, solid_angle_norm<Real>);
-    add_case<SphereVisibleArea, float>(r, "sphere-visible-area", c, visible_area_norm<float>, kVisibleAreaFloat);
-    add_case<SphereVisibleArea, double>(r, "sphere-visible-area", c, visible_area_norm<double>);
-    add_case<SphereVisibleArea, Real>(r, "sphere-visible-area", c, visible_area_norm<Real>);
-  }
+  for (const SphereConfig& c : kConfigs)
+    SphereKernels::for_each([&]<template <class> class K>() {
+      static_assert(check_of(K<Real>::name), "a sphere kernel without its entry in kChecks");
+      add_case<K, float>(r, c);
+      add_case<K, double>(r, c);
+      add_case<K, Real>(r, c);
+    });
 }
 
 }  // namespace warpcheck::validation

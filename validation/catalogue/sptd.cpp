@@ -1,13 +1,14 @@
-// SPTD kernels (Dupuy, Heitz & Belcour 2017) and LTC polygon sampling (Peters 2021 Sec. 4.1), with their named
-// configurations: pivots up to |r_p| = 0.999, all three shapes of the clamped cosine's projected cap region,
-// the pivot phase function alone and jointly with a sphere light, and LTC transforms from the identity to
-// near-singular.
+// SPTD kernels (Dupuy, Heitz & Belcour 2017) and LTC polygon sampling (Peters 2021 Sec. 4.1), catalogue.h's
+// SptdKernels, with their named configurations: pivots up to |r_p| = 0.999, all three shapes of the clamped
+// cosine's projected cap region, the pivot phase function alone and jointly with a sphere light (configurations
+// of the uniform kernel), and LTC transforms from the identity to near-singular.
 #include <Eigen/SVD>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string_view>
 
-#include "catalogue/kernels_sptd.h"
-#include "warpcheck/sptd.h"
+#include "catalogue/sptd_samplers.h"
 #include "warpcheck/validation/registry.h"
 
 namespace warpcheck::validation {
@@ -59,16 +60,16 @@ std::vector<SptdConfig> sptd_configs() {
        sptd(Vec3L(0.2L, 0, 0.3L), C, -kZ, cap(Vec3L(1, 0, 0.2L), 0.3L))},
       {"sptd-cosine-cap", "pivot-0.99", "clamped cosine, |r_p| = 0.99, cap half-angle 60 deg",
        sptd(diag * 0.99L, C, Vec3L(0.2L, 0.1L, 1).normalized(), cap(diag + Vec3L(0.3L, 0.2L, 0), 0.5L))},
-      {"sptd-phase", "g-0.5", "pivot phase function (Eq. 25), g_p = 0.5, whole sphere",
+      {"sptd-uniform-cap", "phase-g-0.5", "pivot phase function (Eq. 25), g_p = 0.5, whole sphere",
        pivot_phase_geometry<Real>(diag, 0.5L)},
-      {"sptd-phase", "g-minus-0.7", "pivot phase function, g_p = -0.7 (back scattering), whole sphere",
+      {"sptd-uniform-cap", "phase-g-minus-0.7", "pivot phase function, g_p = -0.7 (back scattering), whole sphere",
        pivot_phase_geometry<Real>(diag, -0.7L)},
-      {"sptd-phase", "g-0.99", "pivot phase function, g_p = 0.99, whole sphere",
+      {"sptd-uniform-cap", "phase-g-0.99", "pivot phase function, g_p = 0.99, whole sphere",
        pivot_phase_geometry<Real>(diag, 0.99L)},
-      {"sptd-phase-sphere-light", "hg-0.9",
+      {"sptd-uniform-cap", "phase-sphere-light-hg-0.9",
        "pivot phase function fitted to HG g = 0.9 (Eq. 27), sampled jointly with a sphere light (Sec. 6.2)",
        pivot_phase_sphere_light_geometry<Real>(Vec3L(1, 0.2L, 0.4L).normalized(), hg_to_pivot(0.9L), light)},
-      {"sptd-phase-sphere-light", "back-0.6", "g_p = -0.6, light behind the propagation direction",
+      {"sptd-uniform-cap", "phase-sphere-light-back-0.6", "g_p = -0.6, light behind the propagation direction",
        pivot_phase_sphere_light_geometry<Real>(Vec3L(-1, 0, -0.3L).normalized(), -0.6L, light)},
   };
 }
@@ -91,7 +92,7 @@ Real quadrature_of_eq8(const SptdCapGeometry<Real>& g) {
   return integrate_cap_region([d](const Vec3L& w) { return sptd_density(d, w); }, g.cap, 0, 1, 0, kTwoPi<Real>, 1e-10L);
 }
 
-template <class T> void add_sptd(Registry& r, const SptdConfig& c) {
+template <template <class> class K, class T> void add_sptd(Registry& r, const SptdConfig& c) {
   Case k;
   k.kernel = c.kernel;
   k.scalar = scalar_name<T>();
@@ -99,8 +100,8 @@ template <class T> void add_sptd(Registry& r, const SptdConfig& c) {
   k.description = c.description;
   k.make = [c] {
     const bool whole_sphere = c.g.cap.one_minus_cos >= 2;
-    SamplerUnderTest s = bind_sptd_cap<T>(c.kernel, c.name, c.g, whole_sphere ? Real(1) : quadrature_of_eq8(c.g));
-    s.expect_no_sample = !make_sptd_cap_view(c.g).valid();
+    SamplerUnderTest s = sptd_cap_sampler<K, T>(c.name, c.g, whole_sphere ? Real(1) : quadrature_of_eq8(c.g));
+    s.expect_no_sample = !K<Real>::view(c.g).valid();
     const Real rp = c.g.sptd.pivot.norm();
     set_tolerance<T>(s, (1 + rp) / (1 - rp), "float rounding: 64 eps (1 + |r_p|) / (1 - |r_p|)");
     return s;
@@ -168,12 +169,12 @@ Real condition_number(const Mat3<Real>& m) {
 
 template <class T> void add_ltc(Registry& r, const LtcConfig& c) {
   Case k;
-  k.kernel = "polygon-ltc";
+  k.kernel = PolygonLtc<T>::name;
   k.scalar = scalar_name<T>();
   k.config = c.name;
   k.description = c.description;
   k.make = [c] {
-    SamplerUnderTest s = bind_ltc<T>("polygon-ltc", c.name, c.g);
+    SamplerUnderTest s = ltc_sampler<T>(c.name, c.g);
     // Float: rounding of M^-1 and of the transformed vertices is amplified by ~cond(M); 64 eps cond(M), stated
     // a priori (not tuned).
     const Real kappa = condition_number(c.g.m);
@@ -185,17 +186,29 @@ template <class T> void add_ltc(Registry& r, const LtcConfig& c) {
 
 }  // namespace
 
+// Each SPTD configuration names its kernel (one of the cap kernels, with that kernel's base); LTC has its own.
 void register_sptd_kernels(Registry& r) {
-  for (const SptdConfig& c : sptd_configs()) {
-    add_sptd<float>(r, c);
-    add_sptd<double>(r, c);
-    add_sptd<Real>(r, c);
-  }
-  for (const LtcConfig& c : ltc_configs()) {
-    add_ltc<float>(r, c);
-    add_ltc<double>(r, c);
-    add_ltc<Real>(r, c);
-  }
+  const std::vector<SptdConfig> configs = sptd_configs();
+  std::size_t registered = 0;
+  SptdKernels::for_each([&]<template <class> class K>() {
+    if constexpr (std::is_same_v<typename K<Real>::Geometry, SptdCapGeometry<Real>>) {
+      for (const SptdConfig& c : configs) {
+        if (c.kernel != std::string_view(K<Real>::name) || c.g.sptd.base != K<Real>::base) continue;
+        add_sptd<K, float>(r, c);
+        add_sptd<K, double>(r, c);
+        add_sptd<K, Real>(r, c);
+        ++registered;
+      }
+    } else {
+      static_assert(std::is_same_v<K<Real>, PolygonLtc<Real>>, "an SPTD-family kernel without configurations");
+      for (const LtcConfig& c : ltc_configs()) {
+        add_ltc<float>(r, c);
+        add_ltc<double>(r, c);
+        add_ltc<Real>(r, c);
+      }
+    }
+  });
+  if (registered != configs.size()) throw std::logic_error("an SPTD configuration of no SPTD cap kernel or base");
 }
 
 }  // namespace warpcheck::validation

@@ -74,9 +74,9 @@ Search case3_search() {
     };
     const L p1 = proj_pdf(p[2], p[3]), p2 = proj_pdf(p[4], p[5]);
     if (std::isnan(p1) || std::isnan(p2)) return kNaN;
-    // The bound's (t_x - (c_x + r_x)) / -r_x cancels catastrophically as h -> 0- (a first run found "bound 0" at
-    // depth 3e-21). Exact algebra with Alg. 1's t_x = v / w_dx, c_x = w_dx v, r_x = h r_y, w_dx^2 + h^2 = 1:
-    // t_x - c_x = v h^2 / w_dx, so the quotient is 1 + v |h| / (w_dx r_y).
+    // The bound's (t_x - (c_x + r_x)) / -r_x cancels catastrophically as h -> 0- (to 0 at depth 3e-21). Exact
+    // algebra with Alg. 1's t_x = v / w_dx, c_x = w_dx v, r_x = h r_y, w_dx^2 + h^2 = 1: t_x - c_x = v h^2 / w_dx,
+    // so the quotient is 1 + v |h| / (w_dx r_y).
     const L bound = (v.c_x - v.r_x) / v.t_x * std::sqrt(1 + v.v * std::abs(v.h) / (v.w_dx * v.r_y));
     const L r = p1 / p2 / bound;
     return std::isfinite(r) ? r : kInf;

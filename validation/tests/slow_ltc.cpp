@@ -1,7 +1,7 @@
 // The battery on LTC sampling of a polygon (Peters 2021 Sec. 4.1) for a random and an ill-conditioned M.
 #include <gtest/gtest.h>
 
-#include "catalogue/kernels_sptd.h"
+#include "catalogue/sptd_samplers.h"
 #include "ltc_fixtures.h"
 #include "warpcheck/validation/battery.h"
 #include "warpcheck/validation/registry.h"
@@ -18,7 +18,7 @@ TEST(Ltc, BatteryPassesForRandomAndIllConditionedM) {
   const auto pg = test_polygon();
   const std::pair<const char*, M3> cases[] = {{"random", random_m(r)}, {"ill-conditioned", narrow_m()}};
   for (const auto& [name, m] : cases) {
-    const auto s = validation::bind_ltc<double>("polygon-ltc", name, LtcPolygonGeometry<L>{pg, m});
+    const auto s = validation::ltc_sampler<double>(name, LtcPolygonGeometry<L>{pg, m});
     ASSERT_FALSE(s.expect_no_sample) << name;
     for (const auto& res : validation::validate(s, o, 0.01))
       EXPECT_TRUE(res.passed) << name << " " << res.test << ": " << res.detail;

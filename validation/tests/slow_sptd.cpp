@@ -4,7 +4,7 @@
 // the samplers' densities sample by sample.
 #include <gtest/gtest.h>
 
-#include "catalogue/kernels_sptd.h"
+#include "catalogue/sptd_samplers.h"
 #include "warpcheck/sptd.h"
 #include "warpcheck/validation/battery.h"
 
@@ -59,7 +59,8 @@ TEST(SptdBattery, PassesOnPivotsIncludingNormCloseToOne) {
     if (std::string(bc.name) == "cosine-ellipse") {
       EXPECT_TRUE(v.cosine.ellipse_only);
     }
-    const auto s = validation::bind_sptd_cap<double>("sptd", bc.name, g);
+    const auto s = bc.base == SptdBase::kUniform ? validation::sptd_cap_sampler<SptdUniformCap, double>(bc.name, g)
+                                                 : validation::sptd_cap_sampler<SptdCosineCap, double>(bc.name, g);
     const auto results = validation::validate(s, o, 0.01);
     for (const auto& r : results) EXPECT_TRUE(r.passed) << bc.name << " " << r.test << ": " << r.detail;
   }

@@ -10,7 +10,7 @@
 #include <limits>
 #include <random>
 
-#include "catalogue/kernels_sptd.h"
+#include "catalogue/sptd_samplers.h"
 #include "ltc_fixtures.h"
 #include "warpcheck/mis.h"
 #include "warpcheck/validation/battery.h"

@@ -10,7 +10,7 @@
 #include <boost/math/quadrature/gauss_kronrod.hpp>
 
 #include "autodiff_eigen.h"
-#include "catalogue/kernels_sptd.h"
+#include "catalogue/sptd_samplers.h"
 #include "warpcheck/sptd.h"
 #include "warpcheck/validation/battery.h"
 

@@ -1,14 +1,15 @@
-// bench_table: the ratio table of issue 9 from Google Benchmark JSON (written by build/warpcheck_bench).
+// bench_table: the ratio table of the kernel benchmarks from Google Benchmark JSON (written by build/warpcheck_bench).
 //
 //   scripts/bench.sh                                  (runs the benchmarks, then this tool)
 //   build/bench_table data/bench/results.json [--markdown]
 //
 // Per-sample time t = 1 / items_per_second (CPU time) of each benchmark; the baseline of the same scalar,
-// configuration and samples-per-light mode (sphere_baseline / polygon_baseline: reading the random numbers and
-// the geometry only) is subtracted, as the papers do. Ratios:
-//   projected_cap / sphere_solid_angle          per q_z, 1 and 500 samples per light (target at 500: <= 2)
-//   polygon_projected / polygon_solid_angle     per vertex count, central and decentral (target decentral: <= 4)
-//   sphere_solid_angle / sphere_solid_angle_batch  per q_z at 500 (speed-up of the batch; target float: >= 3)
+// configuration and samples-per-light mode ("baseline": reading the random numbers and the geometry only) is
+// subtracted, as the papers do. Ratios:
+//   sphere-projected-cap / sphere-solid-angle   per q_z, 1 and 500 samples per light (target at 500: <= 2)
+//   polygon-projected-solid-angle / polygon-solid-angle   per vertex count, central and decentral (target
+//                                               decentral: <= 4)
+//   sphere-solid-angle / its batch API          per q_z at 500 (speed-up of the batch; target float: >= 3)
 // beside the papers' ratios, computed from the published tables (not measured by us):
 //   Peters & Dachsbacher 2019 Table 2 (offline renderer, ns per sample, baseline row subtracted):
 //     (ours - baseline) / (solid angle - baseline);
@@ -86,9 +87,10 @@ int main(int argc, char** argv) {
     if (!o.contains("items_per_second")) continue;
     t[std::string(o.at("name").as_string())] = 1.0 / o.at("items_per_second").to_number<double>();
   }
-  auto net = [&](const std::string& kernel, const std::string& family,
-                 const std::string& rest) -> std::optional<double> {
-    const auto k = t.find(kernel + rest), base = t.find(family + "_baseline" + rest);
+  // KERNEL/SCALAR/CONFIG/spl=S[suffix] minus baseline/SCALAR/CONFIG/spl=S; rest = /SCALAR/CONFIG/spl=S.
+  auto net = [&](const std::string& kernel, const std::string& rest,
+                 const std::string& suffix = "") -> std::optional<double> {
+    const auto k = t.find(kernel + rest + suffix), base = t.find("baseline" + rest);
     if (k == t.end() || base == t.end()) return std::nullopt;
     return k->second - base->second;
   };
@@ -105,7 +107,7 @@ int main(int argc, char** argv) {
     for (int spl : {1, 500})
       for (const char* qz : {"2", "0.1", "-0.1", "-0.9"}) {
         const std::string rest = std::string("/") + T + "/qz=" + qz + "/spl=" + std::to_string(spl);
-        const auto s = net("sphere_solid_angle", "sphere", rest), p = net("projected_cap", "sphere", rest);
+        const auto s = net("sphere-solid-angle", rest), p = net("sphere-projected-cap", rest);
         const auto r = ratio(p, s);
         std::printf("%-7s %-5s %5d %10s %10s %8s %8s %7s\n", T, qz, spl,
                     fmt(s ? std::optional(*s * 1e9) : std::nullopt).c_str(),
@@ -122,7 +124,7 @@ int main(int argc, char** argv) {
         for (int n : {3, 4, 5}) {
           const std::string config = std::string(central ? "central-" : "decentral-") + std::to_string(n);
           const std::string rest = std::string("/") + T + "/" + config + "/spl=" + std::to_string(spl);
-          const auto s = net("polygon_solid_angle", "polygon", rest), p = net("polygon_projected", "polygon", rest);
+          const auto s = net("polygon-solid-angle", rest), p = net("polygon-projected-solid-angle", rest);
           const auto r = ratio(p, s);
           std::printf("%-7s %-12s %5d %10s %10s %8s %8s %7s\n", T, config.c_str(), spl,
                       fmt(s ? std::optional(*s * 1e9) : std::nullopt).c_str(),
@@ -135,7 +137,7 @@ int main(int argc, char** argv) {
   for (const char* T : {"float", "double"})
     for (const char* qz : {"2", "0.1", "-0.1", "-0.9"}) {
       const std::string rest = std::string("/") + T + "/qz=" + qz + "/spl=500";
-      const auto s = net("sphere_solid_angle", "sphere", rest), b = net("sphere_solid_angle_batch", "sphere", rest);
+      const auto s = net("sphere-solid-angle", rest), b = net("sphere-solid-angle", rest, "/batch");
       const auto r = ratio(s, b);
       std::printf("%-7s %-5s %10s %10s %8s %7s\n", T, qz, fmt(s ? std::optional(*s * 1e9) : std::nullopt).c_str(),
                   fmt(b ? std::optional(*b * 1e9) : std::nullopt).c_str(), fmt(r).c_str(),

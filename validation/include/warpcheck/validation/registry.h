@@ -1,8 +1,9 @@
 // warpcheck/validation/registry.h: the kernels and named configurations the CLI validates.
 //
-// Each kernel family has one registrar function (register_<family>_kernels) in validation/src/registry_<family>.cpp
-// that adds one Case per (kernel, scalar type, configuration). default_registry() calls every registrar; adding
-// a family means adding its registrar there.
+// Each kernel family of lib/warpcheck/catalogue.h has one registrar function (register_<family>_kernels) in
+// validation/catalogue/<family>.cpp that adds one Case per (kernel, scalar type, configuration), named by the
+// kernel's catalogue name. default_registry() calls every registrar; adding a family means adding its registrar
+// there.
 #pragma once
 
 #include <functional>

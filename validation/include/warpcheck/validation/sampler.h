@@ -7,9 +7,11 @@
 //     `sample` and `pdf` are required, and so is `bounding_cap`, a spherical cap that contains every
 //     direction the sampler can return (the chi-square grid is laid over it, so make it tight).
 //
-//  2. A kernel type satisfying the `Kernel` concept below (a Scalar, a Geometry, static sample / pdf /
-//     bounding_cap): `bind_kernel<K>(geometry)` builds the SamplerUnderTest, and `bind_kernel<K, KRef>` also
-//     wires KRef (the same kernel in long double) as the reference warp for the Jacobian check.
+//  2. A kernel trait satisfying the `Kernel` concept below, as lib/warpcheck/catalogue.h's kernels do (name,
+//     Scalar, Geometry, View, static view / sample / pdf / bounding_cap): `bind_kernel<K>(config, geometry)`
+//     builds the SamplerUnderTest, and `bind_kernel<K, KRef>` also wires KRef (the same kernel in long double)
+//     as the reference warp for the Jacobian check. A kernel without a per-light precomputation takes
+//     `using View = Geometry;` and a `view` that returns the geometry.
 //
 // Conventions: directions are unit world-space vectors; densities are with respect to solid angle; a sample
 // with valid == false means the sampler declined (allowed only where the sampler also reports pdf == 0
@@ -62,8 +64,8 @@ struct SamplerUnderTest {
   std::vector<Real> kinks_u0, kinks_u1;
   // Optional independent normalisation checks.
   std::vector<Normalization> normalizations;
-  // Relative tolerance of the deterministic checks (pdf consistency, integral, normalisation). The
-  // issue's 1e-6 for double and long double; a float sampler states its own, measured, tolerance.
+  // Relative tolerance of the deterministic checks (pdf consistency, integral, normalisation): 1e-6 for double
+  // and long double; a float sampler states its own, measured, tolerance.
   Real tolerance = 1e-6L;
   // Why the tolerance differs from 1e-6, if it does (printed in the JSON results).
   std::string tolerance_note;
@@ -80,13 +82,24 @@ struct SamplerUnderTest {
 // ---- Kernel concept: for samplers written as warpcheck-style kernels ---------------------------------------
 
 template <class K>
-concept Kernel = requires(const typename K::Geometry& g, typename K::Scalar u, const Vec3<typename K::Scalar>& w) {
-  typename K::Scalar;
-  typename K::Geometry;
-  { K::sample(g, Vec2<typename K::Scalar>(u, u)) } -> std::convertible_to<DirectionSample<typename K::Scalar>>;
-  { K::pdf(g, w) } -> std::convertible_to<typename K::Scalar>;
+concept Kernel = requires(const typename K::Geometry& g, const typename K::View& v, const Vec2<typename K::Scalar>& u,
+                          const Vec3<typename K::Scalar>& w) {
+  { K::name } -> std::convertible_to<std::string>;
+  { K::view(g) } -> std::convertible_to<typename K::View>;
+  { K::sample(v, u) } -> std::convertible_to<DirectionSample<typename K::Scalar>>;
+  { K::pdf(v, w) } -> std::convertible_to<typename K::Scalar>;
   { K::bounding_cap(g) } -> std::convertible_to<Cap<typename K::Scalar>>;
 };
+
+// A kernel's documented kinks in u0 and u1 (catalogue.h), empty if it declares none.
+template <Kernel K> std::vector<Real> kernel_kinks(const typename K::Geometry& g, int axis) {
+  std::vector<typename K::Scalar> k;
+  if constexpr (requires { K::kinks_u0(g); })
+    if (axis == 0) k = K::kinks_u0(g);
+  if constexpr (requires { K::kinks_u1(g); })
+    if (axis == 1) k = K::kinks_u1(g);
+  return std::vector<Real>(k.begin(), k.end());
+}
 
 template <class T> Vec3L to_long(const Vec3<T>& v) { return v.template cast<Real>(); }
 
@@ -112,33 +125,39 @@ template <class T> Sample to_sample(const DirectionSample<T>& s) {
   return Sample{to_long(s.direction), Real(s.pdf), s.valid()};
 }
 
-// Binds kernel K to geometry g. The geometry is converted to K's scalar type by the caller.
-template <Kernel K>
-SamplerUnderTest bind_kernel(std::string kernel, std::string config, const typename K::Geometry& g) {
+// Binds kernel K to geometry g (in K's scalar type; the caller converts it): sample and pdf on one view of g,
+// K's bounding cap and kinks.
+template <Kernel K> SamplerUnderTest bind_kernel(std::string config, const typename K::Geometry& g) {
   using T = typename K::Scalar;
   SamplerUnderTest s;
-  s.kernel = std::move(kernel);
+  s.kernel = K::name;
   s.config = std::move(config);
   s.scalar = scalar_name<T>();
-  s.sample = [g](double u0, double u1) { return to_sample(K::sample(g, Vec2<T>(to_unit<T>(u0), to_unit<T>(u1)))); };
-  s.pdf = [g](const Vec3L& w) { return Real(K::pdf(g, w.template cast<T>())); };
+  s.sample = [v = K::view(g)](double u0, double u1) {
+    return to_sample(K::sample(v, Vec2<T>(to_unit<T>(u0), to_unit<T>(u1))));
+  };
+  s.pdf = [v = K::view(g)](const Vec3L& w) { return Real(K::pdf(v, w.template cast<T>())); };
   const Cap<T> cap = K::bounding_cap(g);
   s.bounding_cap = Cap<Real>{to_long(cap.axis).normalized(), Real(cap.one_minus_cos)};
+  s.kinks_u0 = kernel_kinks<K>(g, 0);
+  s.kinks_u1 = kernel_kinks<K>(g, 1);
   return s;
 }
 
-// As above, with KRef (the same kernel in long double, on the same geometry converted) as the reference warp.
-template <Kernel K, Kernel KRef> SamplerUnderTest bind_kernel(std::string kernel, std::string config,
-                                                              const typename K::Geometry& g,
-                                                              const typename KRef::Geometry& g_ref) {
-  SamplerUnderTest s = bind_kernel<K>(std::move(kernel), std::move(config), g);
-  s.reference_sample = [g_ref](Real u0, Real u1) {
-    using R = typename KRef::Scalar;
-    return to_sample(KRef::sample(g_ref, Vec2<R>(R(u0), R(u1))));
+// As above, with KRef (the same kernel in long double, on the same geometry converted) as the reference warp;
+// the bounding cap and the kinks come from KRef.
+template <Kernel K, Kernel KRef>
+SamplerUnderTest bind_kernel(std::string config, const typename K::Geometry& g, const typename KRef::Geometry& g_ref) {
+  SamplerUnderTest s = bind_kernel<K>(std::move(config), g);
+  using R = typename KRef::Scalar;
+  s.reference_sample = [v = KRef::view(g_ref)](Real u0, Real u1) {
+    return to_sample(KRef::sample(v, Vec2<R>(R(u0), R(u1))));
   };
   // The bounding cap from the long double geometry is tighter for tiny lights in float.
   const auto cap = KRef::bounding_cap(g_ref);
   s.bounding_cap = Cap<Real>{to_long(cap.axis).normalized(), Real(cap.one_minus_cos)};
+  s.kinks_u0 = kernel_kinks<KRef>(g_ref, 0);
+  s.kinks_u1 = kernel_kinks<KRef>(g_ref, 1);
   return s;
 }
 
