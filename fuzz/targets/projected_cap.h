@@ -160,7 +160,9 @@ void check_projected_cap_kernel(FuzzedDataProvider& in, const SphereLightGeometr
         radius, 16 * eps<T>(), std::min(m.light, m.height), tol, geo);
   }
   // The density at an arbitrary unit direction.
-  const Vec3<T> w = safe_normalized(in.ConsumeBool() ? vec3<T>(in) : near(in, view.sphere.frame.z));
+  // Near the direction to the centre; an invalid view's frame is not set, and then near the z axis.
+  const Vec3<T> axis = view.valid() ? view.sphere.frame.z : Vec3<T>(T(0), T(0), T(1));
+  const Vec3<T> w = safe_normalized(in.ConsumeBool() ? vec3<T>(in) : near(in, axis));
   const T p = mutate.pdf(pdf_projected_spherical_cap<T, M>(view, w));
   const std::string geo = describe(g, Vec2<T>(Vec2<T>::Zero()), name) + "pdf at w " + show(w) + "\n";
   WARPCHECK_FUZZ_REQUIRE(std::isfinite(p) && p >= T(0), "pdf not finite and >= 0", geo << "pdf " << p << "\n");

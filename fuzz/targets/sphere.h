@@ -49,7 +49,9 @@ template <class T> void check_sphere(FuzzedDataProvider& in) {
   }
   // The densities at an arbitrary direction: finite, >= 0, zero outside the light and for invalid geometry.
   // Directions are unit vectors (the pdf's contract), so the decoded vector is normalised in T first.
-  const Vec3<T> w = safe_normalized(in.ConsumeBool() ? vec3<T>(in) : near(in, view.frame.z));
+  // Near the direction to the centre; an invalid view's frame is not set, and then near the z axis.
+  const Vec3<T> axis = view.valid() ? view.frame.z : Vec3<T>(T(0), T(0), T(1));
+  const Vec3<T> w = safe_normalized(in.ConsumeBool() ? vec3<T>(in) : near(in, axis));
   const T p0 = pdf_sphere_solid_angle(g, w), p1 = pdf_sphere_visible_area(g, w);
   const std::string geo = describe(g, Vec2<T>(Vec2<T>::Zero()), "sphere pdf") + "w " + show(w) + "\n";
   WARPCHECK_FUZZ_REQUIRE(std::isfinite(p0) && p0 >= T(0) && std::isfinite(p1) && p1 >= T(0), "pdf not finite and >= 0",
