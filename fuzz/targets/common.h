@@ -6,7 +6,7 @@
 // entry (fuzz/entry.h) turns that into a crash report; the g++ replay driver (fuzz/replay.cpp) into a failed
 // ctest. See fuzz/README.md for the targets, the campaign script and the triage of findings.
 //
-// Decoding (toolchain.md: ConsumeFloatingPoint never yields NaN, Inf or subnormals, so we never use it). Every
+// Decoding (FuzzedDataProvider's ConsumeFloatingPoint never yields NaN, Inf or subnormals, so it is not used). Every
 // scalar starts with a mode byte: a table of special values (signed zeros, 1 +- ulp, epsilon, the smallest
 // normal and subnormal, the largest finite, Inf, NaN, ...), a small integer (exact coincidences: coplanar
 // vertices, collinear points, zero-length edges), raw bits of T, or a moderate value. Geometry is then built
@@ -17,8 +17,7 @@
 // Order. Every value is decoded in its own statement (or in a declaration list, or a comma expression, which are
 // sequenced): the order in which the operands of one expression or the arguments of one call are evaluated is
 // unspecified, and g++ (right to left) and clang (left to right) differ, so an input that libFuzzer (clang) found
-// would decode to another geometry in the g++ replay. Where an earlier version combined two decodings in one
-// expression, they are now decoded left to right, as clang did.
+// would decode to another geometry in the g++ replay.
 //
 // Tolerances (the geometry's conditioning). A kernel in precision T first forms differences V - x of world
 // coordinates; each carries an absolute rounding error of about eps_T (|V|_inf + |x|_inf), i.e. an angular
@@ -29,8 +28,7 @@
 // angular distance to the light's boundary (measured conservatively: the distance to every bounding great
 // circle, resp. the ray's miss distance over d for a sphere) is at most
 //     tol = kTolUlps * eps_T * kappa,   kappa = max(1, max_k (|V_k|_inf + |x|_inf + 16 min_T) / |V_k - x|)
-// (for a sphere, V is the centre and |V - x| = d, kappa = max(1, (|c|_inf + |x|_inf) / d)), kTolUlps = 64. (Until
-// 2026-12-03 this comment said 1 + max_k; the code has always taken the larger of the two, the stricter.)
+// (for a sphere, V is the centre and |V - x| = d, kappa = max(1, (|c|_inf + |x|_inf) / d)), kTolUlps = 64.
 // kappa grows without bound for a shading point close to a vertex relative to the coordinates' magnitude: that
 // is exactly when the input coordinates themselves no longer determine the direction. The reference is
 // computed in long double from the exact T inputs (exact conversion; the edge normals by Kahan's
@@ -38,7 +36,7 @@
 #pragma once
 
 // g++ builds (the replay driver) name the header's installed path in WARPCHECK_FDP_HEADER rather than putting
-// clang's resource include directory on the path (its stddef.h breaks GCC; toolchain.md).
+// clang's resource include directory on the path (its stddef.h breaks GCC).
 #ifdef WARPCHECK_FDP_HEADER
 #include WARPCHECK_FDP_HEADER
 #else

@@ -143,8 +143,8 @@ template <class T> LtcReference ltc_reference(const LtcPolygonGeometry<T>& g) {
                                (inv_t.template cast<L>() * r.m - Mat3<L>::Identity()).norm());
   r.frame = Frame<L>::from_z(Vec3<L>(n / nn));
   // LU with full pivoting, not the cofactor formula: that one's inverse of an ill-conditioned M is a right inverse
-  // only, even in long double (fuzz_ltc_double f84856d2: |X M - I| 2.2), and not inverse(): it divides by 0 for a
-  // singular M. sigma_min > 0 above; a zero pivot is tested all the same.
+  // only, even in long double (|X M - I| = 2.2 at cond(M) 6e10), and not inverse(): it divides by 0 for a singular M.
+  // sigma_min > 0 above; a zero pivot is tested all the same.
   Eigen::FullPivLU<Mat3<L>> lu(r.m);
   lu.setThreshold(L(0));  // any nonzero pivot counts, as the cofactor formula accepted any nonzero determinant
   if (!(lu.rank() == 3)) return r.defined = false, r;
@@ -159,6 +159,60 @@ template <class T> LtcReference ltc_reference(const LtcPolygonGeometry<T>& g) {
     r.transformed.light.vertices[i] =
         r.m_inv * r.frame.to_local(Vec3<L>(g.polygon.light.vertices[i].template cast<L>() - x));
   return r;
+}
+
+// Step (1) of the normaliser check: the kernel's transformed polygon kt = M^-1 P (ltc_transformed_polygon of its
+// local polygon, in T) against the exact one, vertex by vertex. Its vertices are the exact transforms of world
+// vertices moved by e kappa_w + |E|, which M^-1 stretches as angles by |l_k| / (sigma_3 |M^-1 l_k|), plus the
+// product's rounding (e). A light non-planar beyond the offsets' rounding is flattened by the kernel
+// (make_polygon_view, polygon.h): vertex k moves by its distance d_k from the plane, which turns its direction by up
+// to |d_k| / |V_k - x| before M^-1 stretches it. A vertex at the shading point (length 0) has an unbounded stretch
+// and is skipped.
+template <class T> void check_ltc_transformed_vertices(const LtcPolygonGeometry<T>& g,
+                                                       const PolygonLightGeometry<T>& kt, const LtcReference& ref,
+                                                       L kappa_w, const Mutation& mutate) {
+  const L e = L(kTolUlps) * eps<T>();
+  const PolygonLightGeometry<L> kt_l = kt.template cast<L>();
+  const PolygonLifts lifts = polygon_lifts(g.polygon.light);
+  for (int i = 0; i < ref.transformed.light.count && i < kt.light.count; ++i) {
+    const Vec3<L> r = ref.transformed.light.vertices[i], k = mutate.transformed_vertex(kt_l.light.vertices[i]);
+    const Vec3<L> l = ref.m * r;
+    const L rn = r.norm(), kn = k.norm();
+    if (!(rn > 0) || !(kn > 0)) continue;
+    const L stretch = l.norm() / (ref.sigma3 * rn);
+    const L allowed = stretch * (e * kappa_w + ref.inverse_error + std::abs(lifts.d[i]) / l.norm()) + e;
+    const L angle = 2 * std::asin(std::min(L(1), Vec3<L>(r / rn - k / kn).norm() / 2));
+    if (allowed < L(0.5))
+      WARPCHECK_FUZZ_REQUIRE(angle <= allowed, "a vertex of M^-1 P off its exact transform",
+                             describe(g, Vec2<T>(Vec2<T>::Zero()), "ltc view")
+                                 << "vertex " << i << " angle " << angle << " allowed " << allowed << "\n");
+  }
+}
+
+// Step (2): A_Sigma of the view against Lambert's formula (polygon.h's reference) for the kernel's own kt, as
+// make_polygon_view accepts it: flattened onto its plane where the rounding of its vertices (cond(M) eps,
+// ltc_vertex_rounding) leaves it non-planar beyond the offsets' own rounding. The sampler's clip points and edges
+// move by e (1 + kappa_t) as angles, over a boundary of length <= 2 pi, and the sector sum rounds (16 eps). The two
+// steps have separate bounds: one bound for both would have to carry step (1)'s displacement through step (2)'s
+// leverage kappa_t, and A_Sigma's sensitivity to the world's rounding is the problem's conditioning, not the
+// kernel's error. Flattening moves each vertex by at most the non-planarity, which step (1) bounds.
+template <class T> void check_ltc_normaliser(const LtcPolygonGeometry<T>& g, const LtcPolygonView<T>& view,
+                                             const PolygonLightGeometry<T>& kt, const Mutation& mutate) {
+  const L e = L(kTolUlps) * eps<T>();
+  const PolygonView<T> kpv = make_polygon_view(kt, ltc_vertex_rounding(view.m, view.m_inv));
+  PolygonLightGeometry<L> flat_l = kt.template cast<L>();
+  if (kpv.valid() && kpv.flattened)
+    for (int i = 0; i < kpv.local.count; ++i)
+      flat_l.light.vertices[i] = kpv.frame.to_world(kpv.local.v[i]).template cast<L>();
+  const L a_ref = reference_projected_solid_angle(flat_l);
+  const L kappa_k = polygon_kappa<L, T>(flat_l, true);
+  const L rel = a_ref > 0 ? kTwoPi<L> * e * (1 + kappa_k) / a_ref + 16 * eps<T>() : L(1);
+  const L a = L(mutate.normaliser(view.transformed.projected_solid_angle));
+  if (rel < L(0.5))
+    WARPCHECK_FUZZ_REQUIRE(std::abs(a / a_ref - 1) <= rel, "A_Sigma(M^-1 P) differs from Lambert's formula",
+                           describe(g, Vec2<T>(Vec2<T>::Zero()), "ltc view")
+                               << "A_Sigma " << a << " reference (of the kernel's M^-1 P) " << a_ref << " ratio - 1 "
+                               << (a / a_ref - 1) << " allowed " << rel << "\n");
 }
 
 template <class T> void check_ltc(FuzzedDataProvider& in, const Mutation& mutate = {}) {
@@ -189,61 +243,10 @@ template <class T> void check_ltc(FuzzedDataProvider& in, const Mutation& mutate
   // columns' norms, Hadamard's bound).
   const L hadamard = ref.m.col(0).norm() * ref.m.col(1).norm() * ref.m.col(2).norm();
   const bool reflecting = finite_input && ref.det < -e * hadamard;
-
   if (view.valid() && checkable) {
-    // The normaliser, in two steps, each against its own conditioning. (1) The kernel's transformed polygon
-    // M^-1 P (ltc_transformed_polygon of the kernel's local polygon, in T) against the exact one: the vertices are
-    // the exact transforms of world vertices moved by e kappa_w + |E|, which M^-1 stretches as angles by
-    // |l_k| / (sigma_3 |M^-1 l_k|), plus the product's rounding (e). (2) A_Sigma against Lambert's formula for the
-    // kernel's own transformed polygon: the sampler's clip points and edges move by e (1 + kappa_t) as angles, over
-    // a boundary of length <= 2 pi, and the sector sum rounds (16 eps). One bound for both, as before, had to
-    // carry step (1)'s displacement through step (2)'s leverage kappa_t (the vertices' magnitude over an edge's
-    // distance from the origin), which it did not: fuzz_ltc_double a70e6c5b, cond(M) 7e10, a transformed edge with
-    // ends 1.1e11 away passing 4.6e5 from the origin, kappa_t 9.6e5; the kernel's vertices 0.41 off along the light's
-    // plane (3.7e-12 rad), A_Sigma 5.3e-7 off relative, allowed 1.5e-7; with the product of the two worst cases
-    // the bound would be 4.2e-2, no test at all (issue 7). A_Sigma's sensitivity to the world's rounding is the
-    // problem's conditioning, not the kernel's error.
     const PolygonLightGeometry<T> kt = ltc_transformed_polygon(make_polygon_view(g.polygon), view.m_inv);
-    const PolygonLightGeometry<L> kt_l = kt.template cast<L>();
-    // A light non-planar beyond the offsets' rounding is flattened by the kernel (make_polygon_view, polygon.h):
-    // vertex k moves by its distance d_k from the plane, which turns its direction by up to |d_k| / |V_k - x| before
-    // M^-1 stretches it (the 13 corpus inputs that failed here when flattening came in, fuzz_ltc_double 5692ae35).
-    const PolygonLifts lifts = polygon_lifts(g.polygon.light);
-    for (int i = 0; i < ref.transformed.light.count && i < kt.light.count; ++i) {
-      const Vec3<L> r = ref.transformed.light.vertices[i], k = mutate.transformed_vertex(kt_l.light.vertices[i]);
-      const Vec3<L> l = ref.m * r;
-      // A vertex at the shading point (length 0): the stretch is unbounded, and the check is skipped (the
-      // reference divided by 0 there: UBSan, fuzz_ltc_double 5288b69a, issue 7).
-      const L rn = r.norm(), kn = k.norm();
-      if (!(rn > 0) || !(kn > 0)) continue;
-      const L stretch = l.norm() / (ref.sigma3 * rn);
-      const L allowed = stretch * (e * kappa_w + ref.inverse_error + std::abs(lifts.d[i]) / l.norm()) + e;
-      const L angle = 2 * std::asin(std::min(L(1), Vec3<L>(r / rn - k / kn).norm() / 2));
-      if (allowed < L(0.5))
-        WARPCHECK_FUZZ_REQUIRE(angle <= allowed, "a vertex of M^-1 P off its exact transform",
-                               describe(g, Vec2<T>(Vec2<T>::Zero()), "ltc view")
-                                   << "vertex " << i << " angle " << angle << " allowed " << allowed << "\n");
-    }
-    // (2) on the polygon the sectors sum over: M^-1 P as make_polygon_view accepts it, flattened onto its plane where
-    // the rounding of its vertices (cond(M) eps, ltc_vertex_rounding) leaves it non-planar beyond the offsets' own
-    // rounding (polygon.h). On the unflattened polygon Lambert's formula gave 1.3e-11 more, allowed 6.6e-13
-    // (fuzz_ltc_double 511c2f54: cond(M) ~1e6, M^-1 P non-planar by 7e-10 at size 4 and seen from 5.3e-5 off its
-    // plane; the kernel's A_Sigma, in double and in long double, equals Lambert's formula of the flattened polygon
-    // to 20 digits; issue 7). Flattening moves each vertex by at most the non-planarity, which step (1) bounds.
-    const PolygonView<T> kpv = make_polygon_view(kt, ltc_vertex_rounding(view.m, view.m_inv));
-    PolygonLightGeometry<L> flat_l = kt_l;
-    if (kpv.valid() && kpv.flattened)
-      for (int i = 0; i < kpv.local.count; ++i)
-        flat_l.light.vertices[i] = kpv.frame.to_world(kpv.local.v[i]).template cast<L>();
-    const L a_ref = reference_projected_solid_angle(flat_l);
-    const L kappa_k = polygon_kappa<L, T>(flat_l, true);
-    const L rel = a_ref > 0 ? kTwoPi<L> * e * (1 + kappa_k) / a_ref + 16 * eps<T>() : L(1);
-    const L a = L(mutate.normaliser(view.transformed.projected_solid_angle));
-    if (rel < L(0.5))
-      WARPCHECK_FUZZ_REQUIRE(std::abs(a / a_ref - 1) <= rel, "A_Sigma(M^-1 P) differs from Lambert's formula",
-                             describe(g, Vec2<T>(Vec2<T>::Zero()), "ltc view")
-                                 << "A_Sigma " << a << " reference (of the kernel's M^-1 P) " << a_ref << " ratio - 1 "
-                                 << (a / a_ref - 1) << " allowed " << rel << "\n");
+    check_ltc_transformed_vertices(g, kt, ref, kappa_w, mutate);
+    check_ltc_normaliser(g, view, kt, mutate);
   }
 
   const int samples = in.ConsumeIntegralInRange<int>(1, 3);

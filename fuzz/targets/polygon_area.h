@@ -1,5 +1,5 @@
 // fuzz/targets/polygon_area.h: the baseline Turk 1992 (uniform area sampling, density per solid angle), as
-// published in lib/warpcheck/polygon_solid_angle.h. Findings are evidence, not fixed (issue 7).
+// published in lib/warpcheck/polygon_solid_angle.h. Its findings are recorded (triage "known"), not fixed.
 #pragma once
 
 #include "common_polygon.h"

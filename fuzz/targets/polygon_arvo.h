@@ -1,5 +1,5 @@
 // fuzz/targets/polygon_arvo.h: the baseline Arvo 1995 (spherical triangles, as a fan), implemented as
-// published in lib/warpcheck/polygon_solid_angle.h. Findings are evidence, not fixed (issue 7).
+// published in lib/warpcheck/polygon_solid_angle.h. Its findings are recorded (triage "known"), not fixed.
 #pragma once
 
 #include "common_polygon.h"

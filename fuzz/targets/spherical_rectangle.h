@@ -1,5 +1,6 @@
 // fuzz/targets/spherical_rectangle.h: the baseline Urena et al. 2013 (spherical rectangles), as published in
-// lib/warpcheck/spherical_rectangle.h. Inputs lean to rectangles. Findings are evidence, not fixed (issue 7).
+// lib/warpcheck/spherical_rectangle.h. Inputs lean to rectangles. Its findings are recorded (triage "known"), not
+// fixed.
 #pragma once
 
 #include "common_polygon.h"

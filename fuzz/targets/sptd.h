@@ -154,6 +154,120 @@ struct SptdReference {
   }
 };
 
+// The unit vector orthogonal to a in the plane of a and r_p (two Gram-Schmidt passes; any orthogonal one when r_p
+// is parallel to a up to rounding).
+inline Vec3<L> sptd_in_plane(const SptdReference& r, const Vec3<L>& a) {
+  Vec3<L> t = r.rp - r.rp.dot(a) * a;
+  t -= t.dot(a) * a;
+  const L tn = t.norm();
+  return tn > 64 * std::numeric_limits<L>::epsilon() * r.r ? Vec3<L>(t / tn) : Frame<L>::from_z(a).x;
+}
+
+// The circle bounding g(C), as the smaller of the two caps it bounds: axis and half-angle psi_s <= pi/2, from C's
+// boundary points p+- = cos(psi) a +- sin(psi) t in the plane of a and r_p (t: in that plane, orthogonal to a).
+// g is an inversion about r_p (power k) composed with the point reflection through r_p, so |g(p) - g(q)| =
+// k |p - q| / (|p - r_p| |q - r_p|); p+- map to the two ends of a diameter of the image circle (it is symmetric
+// about that plane), whose chord is therefore 2 sin(psi_s) = 2 k sin(psi) / (|p+ - r_p| |p- - r_p|), without
+// cancellation (differences of the images, as in Eq. 7, lose eps / psi_s relatively for tiny caps). The axis is
+// the in-plane direction orthogonal to g(p+) - g(p-) on the side of g(p+) + g(p-).
+struct SptdImageCircle {
+  bool defined = false;
+  Vec3<L> pp, pm, small_axis;
+  L psi_s = 0;
+};
+inline SptdImageCircle sptd_image_circle(const SptdReference& r) {
+  SptdImageCircle c;
+  const Vec3<L> t = sptd_in_plane(r, r.axis);
+  c.pp = std::cos(r.psi) * r.axis + std::sin(r.psi) * t, c.pm = std::cos(r.psi) * r.axis - std::sin(r.psi) * t;
+  const Vec3<L> gp = r.g(c.pp), gm = r.g(c.pm);
+  const L sin_s = std::min(L(1), r.k * std::sin(r.psi) / ((c.pp - r.rp).norm() * (c.pm - r.rp).norm()));
+  const Vec3<L> plane_normal = r.axis.cross(t), chord = gp - gm, sum = gp + gm;
+  // The axis from the sum where that is well conditioned (|sum| = 2 cos(psi_s) >= 1), else from the chord.
+  c.small_axis = sum.norm() >= 1 ? sum : Vec3<L>(plane_normal.cross(chord));
+  if (!(c.small_axis.norm() > 0)) return c;
+  c.small_axis.normalize();
+  if (c.small_axis.dot(sum) < 0) c.small_axis = -c.small_axis;
+  c.psi_s = std::atan2(sin_s, std::max(L(0), c.small_axis.dot(sum) / 2));
+  c.defined = true;
+  return c;
+}
+
+// Whether g(C) is the small cap of the image circle (else its complement), and whether that is decided beyond
+// rounding (`oriented`). A world point q whose side of C is known and whose image g(q) is known is tested against
+// the small cap: g(C) is that cap iff both tests agree. Candidates: r_p's direction p and -p, which g swaps exactly
+// (g(p) = -p), and C's axis +-w_c, whose world margins are psi and pi - psi, with images in long double. The one
+// whose smaller margin from the two circles (C's boundary in the world, the image circle) exceeds its error by the
+// most decides: the images of points near p are beyond long double's resolution when |r_p| is close to 1, and +-p
+// lie on C's boundary when that passes through p. Without a pivot direction (r_p = 0, g(w) = -w) g(C) = -C.
+inline bool sptd_image_is_small_cap(const SptdReference& r, const SptdImageCircle& c, bool* oriented) {
+  if (!(r.r > 0)) return angle_between(Vec3<L>(-c.small_axis), r.axis) < r.psi;
+  const Vec3<L> p = r.rp / r.r;
+  // psi_s's error: the chord formula's distances |p+- - r_p| (differences of nearly equal vectors when r_p is close
+  // to C's boundary) carry ~eps_L / |p+- - r_p| relatively, and k = (1 - r)(1 + r) ~eps_L / (1 - r) (r = |r_p| is
+  // rounded to ~eps_L). A margin smaller than its error says nothing.
+  const L eps_l = std::numeric_limits<L>::epsilon();
+  const L psi_s_error =
+      16 * eps_l *
+      (1 + std::tan(std::min(c.psi_s, L(1.5))) * (1 / (c.pp - r.rp).norm() + 1 / (c.pm - r.rp).norm() + 1 / (1 - r.r)));
+  struct Candidate {
+    Vec3<L> world, image;
+    L image_error;  // of the image point's direction
+  };
+  // g(w) in long double by Eq. 2 verbatim, g = (a d - d x c) / (a^2 + |c|^2), a = w.r_p - 1, d = w - r_p,
+  // c = w x r_p; for unit w, a^2 + |c|^2 = rho^2 (rho = |w - r_p|), |a| = (rho^2 + k) / 2 and |c| <= rho, so
+  // absolute errors ~eps_L in a, c and d move g by at most ~eps_L (1 + 1 / rho + k / rho^2) each; w's own rounding
+  // (eps_L) is stretched by k / rho^2 (Eq. 4). (Eq. 2 does not use k.)
+  auto computed = [&](const Vec3<L>& w) {
+    const L rho = (w - r.rp).norm();
+    return Candidate{w, r.g(w), 16 * eps_l * (1 + 1 / rho + r.k / (rho * rho))};
+  };
+  const Candidate candidates[] = {
+      {p, Vec3<L>(-p), 0}, {Vec3<L>(-p), p, 0}, computed(r.axis), computed(Vec3<L>(-r.axis))};
+  auto margin = [&](const Candidate& q) {
+    const L image = std::abs(angle_between(q.image, c.small_axis) - c.psi_s) - psi_s_error - q.image_error;
+    const L world = std::abs(angle_between(q.world, r.axis) - r.psi) - 16 * eps_l;
+    return std::min(image, world);
+  };
+  const Candidate* best = &candidates[0];
+  for (const Candidate& q : candidates)
+    if (margin(q) > margin(*best)) best = &q;
+  *oriented = margin(*best) > 0;
+  const bool q_in_c = angle_between(best->world, r.axis) < r.psi;
+  return (angle_between(best->image, c.small_axis) < c.psi_s) == q_in_c;
+}
+
+// The normaliser integral_C D = integral_{g(C)} D_std and its relative tolerance. The image radius psi' has two
+// error bounds: the absolute delta_img, and a relative one from the chord formula, whose inputs k, sin(psi) and
+// |p+- - r_p| the kernel knows to eps / (1 - r), rel_sin_c (e for a decoded cap, whose 1 - cos is exact; e kappa for
+// the light's cone) and (e + delta_C) / dist relatively: sin(psi') to rho = e (2 + 1 / (1 - r)) + rel_sin_c +
+// 2 (e + delta_C) / dist, psi' to |tan psi'| rho. The uniform normaliser (1 - cos psi') / 2 moves by sin(psi')
+// dpsi'; the projected solid angle P by sin(psi') I(psi') dpsi' (common_cap.h) plus, for the axis's error
+// delta_img, at most the cap's solid angle times it (as in projected_cap.h), plus the resolution of the kernel's
+// disk coordinates: its abscissae (the ellipse's centre, the cut) carry absolute errors of a few eps, and the
+// projected region's area moves by at most its height 2 sin(psi') per unit of abscissa. Returns false where g(C)
+// lies below the cosine's horizon (the kernel gives no sample; not asserted here).
+template <class T> bool sptd_normaliser(SptdReference& r, L delta_c, L rel_sin_c) {
+  const L e = L(kTolUlps) * eps<T>();
+  const L rho = e * (2 + 1 / (1 - r.r)) + rel_sin_c + 2 * (e + delta_c) / r.dist;
+  const L dpsi = r.whole ? L(0) : std::min(r.delta_img, std::abs(std::tan(r.img_psi)) * rho);
+  if (r.uniform) {
+    r.norm = r.img_omc / 2;
+    r.norm_rel = (r.img_omc > 0 ? std::sin(r.img_psi) * dpsi / r.img_omc : L(1)) + 16 * eps<T>();
+    return true;
+  }
+  const L t_img = angle_between(r.img_axis, r.n);
+  const Quadrature q = reference_cap_projected_solid_angle(t_img, r.img_psi);
+  if (!(q.value > 0)) return false;
+  r.norm = q.value / kPi<L>;
+  r.norm_rel = (std::sin(r.img_psi) * ring_cosine_integral(r.img_psi, t_img) * dpsi +
+                kTwoPi<L> * r.img_omc * r.delta_img + 2 * e * std::sin(r.img_psi) + 16 * q.error) /
+                   q.value +
+               16 * eps<T>();
+  return true;
+}
+
+// The reference for one input (header comment). delta_c: C's angular tolerance; rel_sin_c: the relative tolerance
+// of sin(psi); exact_cap: C from the exact inputs where the kernel builds it (the light's cone), else the decoded cap.
 template <class T>
 SptdReference sptd_reference(const SptdCapGeometry<T>& geo, L delta_c, L rel_sin_c, const Cap<L>* exact_cap = nullptr) {
   SptdReference r;
@@ -180,17 +294,8 @@ SptdReference sptd_reference(const SptdCapGeometry<T>& geo, L delta_c, L rel_sin
   r.n = r.uniform ? Vec3<L>(0, 0, 1) : Vec3<L>(nb.normalized());
   r.whole = r.omc >= 2;
   r.psi = half_angle_of(std::min(r.omc, L(2)));
-  // The unit vector orthogonal to a in the plane of a and r_p (two Gram-Schmidt passes; any orthogonal one when
-  // r_p is parallel to a up to rounding).
-  auto in_plane = [&](const Vec3<L>& a) {
-    Vec3<L> t = r.rp - r.rp.dot(a) * a;
-    t -= t.dot(a) * a;
-    const L tn = t.norm();
-    return tn > 64 * std::numeric_limits<L>::epsilon() * r.r ? Vec3<L>(t / tn) : Frame<L>::from_z(a).x;
-  };
-  // Distance from r_p to the boundary circle of C: the nearest boundary point lies in the plane of w_c and r_p.
-  {
-    const Vec3<L> t = in_plane(r.axis);
+  {  // distance from r_p to the boundary circle of C: the nearest boundary point lies in the plane of w_c and r_p
+    const Vec3<L> t = sptd_in_plane(r, r.axis);
     const Vec3<L> b = std::cos(r.psi) * r.axis + std::sin(r.psi) * t;
     r.dist = r.whole ? L(2) : (b - r.rp).norm();
   }
@@ -198,111 +303,16 @@ SptdReference sptd_reference(const SptdCapGeometry<T>& geo, L delta_c, L rel_sin
     r.img_axis = r.axis, r.img_omc = 2, r.img_psi = kPi<L>;
     r.delta_img = 0;
   } else {
-    // The image cap. g is an inversion about r_p (power k) composed with the point reflection through r_p, so
-    // distances obey |g(p) - g(q)| = k |p - q| / (|p - r_p| |q - r_p|). The boundary points p+- = cos(psi) a +-
-    // sin(psi) t of C in the plane of a and r_p (t: in that plane, orthogonal to a) map to the two ends of a
-    // diameter of the image circle (it is symmetric about that plane), whose chord is therefore
-    //   2 sin(psi_s) = |g(p+) - g(p-)| = 2 k sin(psi) / (|p+ - r_p| |p- - r_p|)
-    // without cancellation (psi_s <= pi/2: the smaller of the two caps the circle bounds; differences of the
-    // images, as in Eq. 7, lose eps / psi_s relatively for tiny caps). That cap's axis is the in-plane direction
-    // orthogonal to g(p+) - g(p-) on the side of g(p+) + g(p-); g(C) is that cap or its complement.
-    const Vec3<L> t = in_plane(r.axis);
-    const Vec3<L> pp = std::cos(r.psi) * r.axis + std::sin(r.psi) * t,
-                  pm = std::cos(r.psi) * r.axis - std::sin(r.psi) * t;
-    const Vec3<L> gp = r.g(pp), gm = r.g(pm);
-    const L sin_s = std::min(L(1), r.k * std::sin(r.psi) / ((pp - r.rp).norm() * (pm - r.rp).norm()));
-    const Vec3<L> plane_normal = r.axis.cross(t), chord = gp - gm, sum = gp + gm;
-    // The axis from the sum where that is well conditioned (|sum| = 2 cos(psi_s) >= 1), else from the chord.
-    Vec3<L> small_axis = sum.norm() >= 1 ? sum : Vec3<L>(plane_normal.cross(chord));
-    if (!(small_axis.norm() > 0)) return r;
-    small_axis.normalize();
-    if (small_axis.dot(sum) < 0) small_axis = -small_axis;
-    const L psi_s = std::atan2(sin_s, std::max(L(0), small_axis.dot(sum) / 2));
-    // Which of the two. A world point q whose side of C is known and whose image g(q) is known, tested against the
-    // small cap: g(C) is that cap iff both tests agree. Candidates: r_p's direction p and -p, which g swaps (g(p) =
-    // -p, derived from the anti-inversion form, so the image is exact), and C's axis w_c and -w_c, whose world
-    // margins are psi and pi - psi, with images g(+-w_c) in long double. Of those we use the one whose smaller margin
-    // from the two circles, C's boundary in the world and the image circle, exceeds its error by the most, so that
-    // neither test is decided by rounding: the images of points near p are beyond long double's resolution when
-    // |r_p| is close to 1 (06d5d669: an image circle of 1.5e-20 rad), and +-p lie on C's boundary when that passes
-    // through p (found with +-p alone: a hemisphere whose plane holds r_p up to 1e-19, so an image hemisphere, was
-    // oriented by rounding; reference densities 14 x and 7.8 x below the kernel's, whose normaliser an independent
-    // grid estimate confirmed, bd8ab879, e4bbaeed). When no candidate decides, the best one orients the image for
-    // the world-space checks (margins), and the densities are not compared (oriented = false). Without a pivot
-    // direction (r_p = 0, g(w) = -w) g(C) = -C.
-    bool small;
-    if (r.r > 0) {
-      const Vec3<L> p = r.rp / r.r;
-      // psi_s carries the relative error of the chord formula's distances |p+- - r_p| (differences of nearly equal
-      // vectors when r_p is close to C's boundary): ~eps_L / |p+- - r_p|, and that of k = (1 - r)(1 + r): r = |r_p|
-      // is rounded to ~eps_L, so k's relative error is ~eps_L / (1 - r) (found by fuzz_sptd_double 3795a46b: 1 - r =
-      // 2.3e-13, psi_s = 2e-3 known to ~1e-9, and p's margin from the image circle, 1.5e-10, decided the orientation
-      // wrongly). A margin smaller than its error says nothing.
-      const L eps_l = std::numeric_limits<L>::epsilon();
-      const L psi_s_error =
-          16 * eps_l *
-          (1 + std::tan(std::min(psi_s, L(1.5))) * (1 / (pp - r.rp).norm() + 1 / (pm - r.rp).norm() + 1 / (1 - r.r)));
-      struct Candidate {
-        Vec3<L> world, image;
-        L image_error;  // of the image point's direction
-      };
-      // g(w) in long double by Eq. 2 verbatim, g = (a d - d x c) / (a^2 + |c|^2), a = w.r_p - 1, d = w - r_p,
-      // c = w x r_p; for unit w, a^2 + |c|^2 = rho^2 (rho = |w - r_p|), |a| = (rho^2 + k) / 2 and |c| <= rho, so
-      // absolute errors ~eps_L in a, c and d move g by at most ~eps_L (1 + 1 / rho + k / rho^2) each; w's own
-      // rounding (eps_L) is stretched by k / rho^2 (Eq. 4). (Eq. 2 does not use k.)
-      auto computed = [&](const Vec3<L>& w) {
-        const L rho = (w - r.rp).norm();
-        return Candidate{w, r.g(w), 16 * eps_l * (1 + 1 / rho + r.k / (rho * rho))};
-      };
-      const Candidate candidates[] = {
-          {p, Vec3<L>(-p), 0}, {Vec3<L>(-p), p, 0}, computed(r.axis), computed(Vec3<L>(-r.axis))};
-      auto margin = [&](const Candidate& c) {
-        const L image = std::abs(angle_between(c.image, small_axis) - psi_s) - psi_s_error - c.image_error;
-        const L world = std::abs(angle_between(c.world, r.axis) - r.psi) - 16 * eps_l;
-        return std::min(image, world);
-      };
-      const Candidate* best = &candidates[0];
-      for (const Candidate& c : candidates)
-        if (margin(c) > margin(*best)) best = &c;
-      r.oriented = margin(*best) > 0;
-      const bool q_in_c = angle_between(best->world, r.axis) < r.psi;
-      small = (angle_between(best->image, small_axis) < psi_s) == q_in_c;
-    } else {
-      small = angle_between(Vec3<L>(-small_axis), r.axis) < r.psi;
-    }
-    r.img_axis = small ? small_axis : Vec3<L>(-small_axis);
-    r.img_psi = small ? psi_s : kPi<L> - psi_s;
+    const SptdImageCircle c = sptd_image_circle(r);
+    if (!c.defined) return r;
+    const bool small = sptd_image_is_small_cap(r, c, &r.oriented);
+    r.img_axis = small ? c.small_axis : Vec3<L>(-c.small_axis);
+    r.img_psi = small ? c.psi_s : kPi<L> - c.psi_s;
     r.img_omc = 2 * std::pow(std::sin(r.img_psi / 2), 2);
     r.delta_img = (delta_c / e) * r.k / (r.dist * r.dist) + 1 + 2 / r.dist;
     r.delta_img *= e;
   }
-  // The normaliser's tolerance. The image radius psi' has two error bounds: the absolute one delta_img (the
-  // image circle's points are known to that angle), and a relative one from the chord formula above, whose
-  // inputs k, sin(psi) and |p+- - r_p| the kernel knows to eps / (1 - r), rel_sin_c (e for a decoded cap, whose
-  // 1 - cos is exact; e kappa for the light's cone, d's relative rounding) and (e + delta_C) / dist relatively:
-  // sin(psi') to rho = e (2 + 1 / (1 - r)) + rel_sin_c + 2 (e + delta_C) / dist, psi' to |tan psi'| rho. The uniform
-  // normaliser (1 - cos psi') / 2 moves by sin(psi') dpsi'; the projected solid angle P by dP/dpsi' dpsi' = sin(psi')
-  // I(psi') dpsi' (common_cap.h) plus, for the axis's error delta_img, at most the cap's solid angle times it (2 pi (1
-  // - cos psi') delta_img, as in projected_cap.h).
-  const L rho = e * (2 + 1 / (1 - r.r)) + rel_sin_c + 2 * (e + delta_c) / r.dist;
-  const L dpsi = r.whole ? L(0) : std::min(r.delta_img, std::abs(std::tan(r.img_psi)) * rho);
-  if (r.uniform) {
-    r.norm = r.img_omc / 2;
-    r.norm_rel = (r.img_omc > 0 ? std::sin(r.img_psi) * dpsi / r.img_omc : L(1)) + 16 * eps<T>();
-  } else {
-    const L t_img = angle_between(r.img_axis, r.n);
-    const Quadrature q = reference_cap_projected_solid_angle(t_img, r.img_psi);
-    if (!(q.value > 0)) return r;  // below the cosine's horizon: the kernel gives no sample (not asserted here)
-    r.norm = q.value / kPi<L>;
-    // Plus the resolution of the kernel's parameterisation (sptd.h: the projected region R in the coordinates of
-    // the unit disk of n): its abscissae (the ellipse's centre x_c, the cut x0) carry absolute errors of a few eps,
-    // and R's area moves by at most its height 2 sin(psi') per unit of abscissa. Relative to a small R that is the
-    // dominant term (e.g. an image cap of 7e-7 rad just across the horizon: its crescent is 4e-13 wide in x).
-    r.norm_rel = (std::sin(r.img_psi) * ring_cosine_integral(r.img_psi, t_img) * dpsi +
-                  kTwoPi<L> * r.img_omc * r.delta_img + 2 * e * std::sin(r.img_psi) + 16 * q.error) /
-                     q.value +
-                 16 * eps<T>();
-  }
+  if (!sptd_normaliser<T>(r, delta_c, rel_sin_c)) return r;
   r.defined = std::isfinite(r.norm) && r.norm > 0;
   return r;
 }

@@ -2,8 +2,8 @@
 // replayed over its stored corpus with a deliberately broken kernel (a sample pdf 1 % high, the sample direction
 // negated, pdf(direction) 1 % high, the light's normaliser 1 % high), must report an invariant violation on a
 // share of the inputs; unbroken, on none (the fuzz_replay tests assert that too). The share asserted (5 %) is
-// below the ones measured when the corpora were stored (table below; printed by each test), so that a corpus
-// re-merged by a campaign keeps passing while a check that lost its teeth does not.
+// well below the shares the stored corpora give (printed by each test; fuzz/README.md lists them), so that a
+// corpus re-merged by a campaign keeps passing while a check that lost its teeth does not.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -70,14 +70,6 @@ TEST(FuzzChecks, UnbrokenKernelsPassOnTheirCorpora) {
   for (const Family& f : kFamilies) EXPECT_EQ(caught_share(f.target, f.check, Mutation::kNone), 0) << f.target;
 }
 
-// Measured when the corpora were stored (build/fuzz/warpcheck_fuzz_tests prints them; 2026-12-01), share of the
-// corpus caught:                   sample pdf x1.01   direction negated   pdf(direction) x1.01   normaliser x1.01
-//   fuzz_projected_cap_double      0.168              0.412               0.168                  0.248
-//   fuzz_projected_cap_float       0.191              0.395               0.191                  0.214
-//   fuzz_ltc_double                0.150              0.150               0.150                  0.132
-//   fuzz_ltc_float                 0.092              0.286               0.092                  0.148
-//   fuzz_sptd_double               0.257              0.246               0.251                  -
-//   fuzz_sptd_float                0.196              0.214               0.186                  -
 // Most of a corpus is degenerate on purpose (invalid lights, samples on the boundary, where a 1 % change of the
 // density is within its own variation): the shares are not the fuzzer's hit rate on a broken kernel, they show
 // that each check still bites. Required: one input in twenty. SPTD has no view-level normaliser check (its
@@ -95,8 +87,8 @@ TEST(FuzzChecks, EachCheckCatchesABrokenKernelOnAtLeastOneInputInTwenty) {
 
 // The LTC family's check of the kernel's M^-1 P vertex by vertex (fuzz/targets/ltc.h) against every vertex turned
 // by 1e-3 rad, which the normaliser check alone may not see (a turn along the light's boundary changes A_Sigma by
-// less than 1 %). Measured when it was added (2026-12-03, build/fuzz/warpcheck_fuzz_tests): caught on 303 of 891
-// double and 231 of 796 float corpus inputs (0.340, 0.290); the rest are invalid or have no well-conditioned vertex.
+// less than 1 %). About a third of the corpus inputs catch it; the rest are invalid or have no well-conditioned
+// vertex.
 TEST(FuzzChecks, TheLtcVertexCheckCatchesATransformedVertexTurnedBy1e3RadOnAtLeastOneInputInTwenty) {
   for (const Family& f : kFamilies) {
     if (std::string(f.target).find("ltc") == std::string::npos) continue;
@@ -105,16 +97,14 @@ TEST(FuzzChecks, TheLtcVertexCheckCatchesATransformedVertexTurnedBy1e3RadOnAtLea
 }
 
 // Negative controls of polygon_margins' relaxations (fuzz/targets/common_polygon.h). Each relaxation accepts an
-// accepted displacement of the light (a merged flat light, the flattened light with its credit), found by a
-// false positive; this shows that on the very inputs that needed them the check still rejects a direction a
-// little way outside the light (outer below -theta / 2). theta is about 100 times the larger of the tolerance and
-// the relaxation's credit, from the triages: 4a059601 has no credit (its delta/2 branch; tol 1.4e-14), e9b7708c
-// a credit of 3.7e-12 rad. `inner` (the excuse for a density of 0) is the minimum over the accepted
-// displacements, the light as given among them, so it has no lower bound to test on lights non-convex as seen
-// from x. Not controlled, and cannot be: 80cce1ce (ltc_double), where x is 0.31 above a light 4.4e12 wide that is
-// non-planar by 0.31 with x's foot inside it; its credit, off / height, is ~1 rad and exceeds pi/2, so every
-// direction is accepted (measured: outer +0.0055 for the direction straight away from the light's plane). Such
-// a light is planar within check_polygon's tolerance, and which side of it x lies on is not determined.
+// accepted displacement of the light (a merged flat light, the flattened light with its credit); on lights that
+// need them, the check must still reject a direction a little way outside the light (outer below -theta / 2).
+// theta is about 100 times the larger of the tolerance and the relaxation's credit. `inner` (the excuse for a
+// density of 0) is the minimum over the accepted displacements, the light as given among them, so it has no lower
+// bound to test on lights non-convex as seen from x. Not controlled, and cannot be: a light non-planar by more than
+// x's height above it with x's foot inside it (e.g. 0.31 above a light 4.4e12 wide that is non-planar by 0.31), whose
+// credit off / height exceeds pi/2, so that every direction is accepted. Such a light is planar within
+// check_polygon's tolerance, and which side of it x lies on is not determined.
 struct MarginCase {
   const char* name;
   Vec3<double> v[4];
@@ -133,7 +123,7 @@ PolygonLightGeometry<double> margin_case_geometry(const MarginCase& c) {
 
 TEST(FuzzChecks, PolygonMarginsRelaxationsStillRejectDirectionsOutsideTheLightByAHundredTimesTheirCredit) {
   const MarginCase cases[] = {
-      {"4a059601 (polygon_solid_angle_double)",
+      {"an edge along the normal of a light non-planar within delta / 2 (no credit)",
        {{-5.8205884556628007e-11, 5.4736550784744359e-48, 0},
         {0, -15.99951171875, -15.87695686519146},
         {5.8205884556628007e-11, 5.4736550784744359e-48, -1},
@@ -142,7 +132,7 @@ TEST(FuzzChecks, PolygonMarginsRelaxationsStillRejectDirectionsOutsideTheLightBy
        {-4, -4.9406564584124654e-324, 3},
        true,
        1e-12},
-      {"e9b7708c (polygon_solid_angle_double)",
+      {"a vertex off the plane within the planarity tolerance (credit 3.7e-12 rad)",
        {{3.96923828125, -1.4551915228366852e-11, 0}, {0, 0, -0.0}, {-4, 0, 0}, {2, -0.0, 3.96923828125}},
        {0, 1, -3.057789944907e-33},
        {0.93463450179615559, 0.13277316173762499, -0.32989337000680469},
