@@ -165,4 +165,44 @@ template <class T> T pdf_ltc_polygon(const LtcPolygonGeometry<T>& g, const Vec3<
   return pdf_ltc_polygon(make_ltc_polygon_view(g), w);
 }
 
+// ---- Catalogue trait (warpcheck/catalogue.h) -----------------------------------------------------------------
+
+template <class T> struct PolygonLtc {
+  static constexpr const char* name = "polygon-ltc";
+  static constexpr const char* description = "LTC over a polygon, Heitz et al. 2016 with Peters 2021 Sec. 4.1";
+  using Scalar = T;
+  using Geometry = LtcPolygonGeometry<T>;
+  using View = LtcPolygonView<T>;
+  static View view(const Geometry& g) { return make_ltc_polygon_view(g); }
+  static DirectionSample<T> sample(const View& v, const Vec2<T>& u) { return sample_ltc_polygon(v, u); }
+  static T pdf(const View& v, const Vec3<T>& w) { return pdf_ltc_polygon(v, w); }
+  // The support is P clipped by the transformed horizon: M times the clipped transformed vertices.
+  static Cap<T> bounding_cap(const Geometry& g) {
+    const View v = view(g);
+    std::array<Vec3<T>, kMaxClippedVertices> w;
+    int n = 0;
+    if (v.valid()) {
+      for (int i = 0; i < v.transformed.clipped.count; ++i)
+        w[n++] = v.frame.to_world(Vec3<T>(v.m * v.transformed.to_world(v.transformed.clipped.v[i])));
+    } else {
+      for (int i = 0; i < g.polygon.light.count && i < kMaxPolygonVertices; ++i)
+        w[n++] = g.polygon.light.vertices[i] - g.polygon.shading.position;
+    }
+    return bounding_cap_of_directions(w.data(), n);
+  }
+  static T normaliser(const View& v) { return v.transformed.projected_solid_angle; }  // of M^-1 P (Eq. 10)
+  // The sectors of M^-1 P picked by u0 (polygon_projected.h): M is smooth, so the LTC warp has their kinks.
+  static std::vector<T> kinks_u0(const Geometry& g) {
+    const View v = view(g);
+    std::vector<T> kinks;
+    if (!v.valid()) return kinks;
+    T cumulative = 0;
+    for (int i = 0; i + 1 < v.transformed.sector_count; ++i) {
+      cumulative += v.transformed.sectors[i].area;
+      kinks.push_back(cumulative / v.transformed.projected_solid_angle);
+    }
+    return kinks;
+  }
+};
+
 }  // namespace warpcheck

@@ -20,6 +20,7 @@
 #include <cmath>
 #include <initializer_list>
 #include <string>
+#include <vector>
 
 #include "warpcheck/core.h"
 
@@ -528,6 +529,50 @@ inline long double reference_solid_angle(const PolygonLightGeometry<long double>
     sum += 2 * std::atan2(a.dot(b.cross(d)), 1 + a.dot(b) + a.dot(d) + b.dot(d));
   }
   return std::abs(sum);
+}
+
+// ---- Helpers of the polygon kernels' catalogue traits (warpcheck/catalogue.h) ----------------------------------
+
+// A cap containing the light's vertices seen from the shading point (for geometry the kernels reject).
+template <class T> Cap<T> polygon_bounding_cap(const PolygonLightGeometry<T>& g) {
+  std::array<Vec3<T>, kMaxPolygonVertices> w;
+  for (int i = 0; i < g.light.count; ++i) w[i] = g.light.vertices[i] - g.shading.position;
+  return bounding_cap_of_directions(w.data(), g.light.count);
+}
+
+// Unit normals of the planes through the shading point and each edge (degenerate edges skipped).
+template <class T> std::vector<Vec3<T>> polygon_edge_planes(const PolygonLightGeometry<T>& g) {
+  std::vector<Vec3<T>> planes;
+  const int n = g.light.count;
+  for (int i = 0; i < n; ++i) {
+    const Vec3<T> e =
+        (g.light.vertices[i] - g.shading.position).cross(g.light.vertices[(i + 1) % n] - g.shading.position);
+    if (e.norm() > T(0)) planes.push_back(e.normalized());
+  }
+  return planes;
+}
+
+// The great circles on which a polygon kernel's density may jump or kink: the edges' planes and the horizon
+// (where the clipped supports end and the projected density's cosine reaches 0).
+template <class T> std::vector<Vec3<T>> polygon_boundary_planes(const PolygonLightGeometry<T>& g) {
+  std::vector<Vec3<T>> planes = polygon_edge_planes(g);
+  if (g.shading.normal.norm() > T(0)) planes.push_back(g.shading.normal.normalized());
+  return planes;
+}
+
+// Kinks in u0 of a warp that picks a piece (fan triangle, sector) by u0 in proportion to its area: the
+// cumulative fractions sum_{i<=k} A_i / A_total strictly inside (0, 1), over the pieces of positive area.
+template <class T, class It> std::vector<T> cumulative_area_fractions(It first, It last) {
+  T total = 0;
+  for (It i = first; i != last; ++i) total += T(*i);
+  std::vector<T> kinks;
+  T sum = 0;
+  if (!(total > T(0))) return kinks;
+  for (It i = first; i != last; ++i) {
+    sum += T(*i);
+    if (T(*i) > T(0) && sum < total) kinks.push_back(sum / total);
+  }
+  return kinks;
 }
 
 }  // namespace warpcheck

@@ -640,4 +640,41 @@ template <class T> T pdf_polygon_projected_solid_angle_biased(const PolygonLight
   return pdf_polygon_projected_solid_angle(make_polygon_projected_view<T, true>(g), w);
 }
 
+// ---- Catalogue traits (warpcheck/catalogue.h) ----------------------------------------------------------------
+
+// kBiased: Sec. 6.4's variant (no iteration, approximate arctangent), biased by design.
+template <class T, bool kBiased> struct PolygonProjectedSolidAngleKernel {
+  static constexpr const char* name =
+      kBiased ? "polygon-projected-solid-angle-biased" : "polygon-projected-solid-angle";
+  static constexpr const char* description = kBiased ? "projected solid angle, Peters 2021 Sec. 6.4 (biased)"
+                                                     : "projected solid angle, Peters 2021 Sec. 3 (2 iterations)";
+  using Scalar = T;
+  using Geometry = PolygonLightGeometry<T>;
+  using View = PolygonProjectedView<T>;
+  static View view(const Geometry& g) { return make_polygon_projected_view<T, kBiased>(g); }
+  static DirectionSample<T> sample(const View& v, const Vec2<T>& u) {
+    return sample_polygon_projected_solid_angle<T, kBiased>(v, u, kBiased ? 0 : 2);
+  }
+  static T pdf(const View& v, const Vec3<T>& w) { return pdf_polygon_projected_solid_angle(v, w); }
+  // The clipped polygon's vertices.
+  static Cap<T> bounding_cap(const Geometry& g) {
+    const View v = view(g);
+    if (!v.valid()) return polygon_bounding_cap(g);
+    std::array<Vec3<T>, kMaxClippedVertices> w;
+    for (int i = 0; i < v.clipped.count; ++i) w[i] = v.to_world(v.clipped.v[i]);
+    return bounding_cap_of_directions(w.data(), v.clipped.count);
+  }
+  static T normaliser(const View& v) { return v.projected_solid_angle; }
+  // The sectors' cumulative area fractions (the sector is picked by u0, Sec. 3.2).
+  static std::vector<T> kinks_u0(const Geometry& g) {
+    const View v = view(g);
+    std::vector<T> a;
+    for (int k = 0; k < v.sector_count; ++k) a.push_back(v.sectors[k].area);
+    return cumulative_area_fractions<T>(a.begin(), a.end());
+  }
+  static std::vector<Vec3<T>> boundary_planes(const Geometry& g) { return polygon_boundary_planes(g); }
+};
+template <class T> using PolygonProjectedSolidAngle = PolygonProjectedSolidAngleKernel<T, false>;
+template <class T> using PolygonProjectedSolidAngleBiased = PolygonProjectedSolidAngleKernel<T, true>;
+
 }  // namespace warpcheck

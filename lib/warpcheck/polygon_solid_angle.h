@@ -404,10 +404,12 @@ template <class T> DirectionSample<T> sample_arvo_triangle_fan(const ArvoFanView
 template <class T> DirectionSample<T> sample_arvo_triangle_fan(const PolygonLightGeometry<T>& g, const Vec2<T>& xi) {
   return sample_arvo_triangle_fan(make_arvo_fan_view(g), xi);
 }
-template <class T> T pdf_arvo_triangle_fan(const PolygonLightGeometry<T>& g, const Vec3<T>& w) {
-  const ArvoFanView<T> v = make_arvo_fan_view(g);
+template <class T> T pdf_arvo_triangle_fan(const ArvoFanView<T>& v, const Vec3<T>& w) {
   if (!v.valid() || !all_finite(w) || !in_fan_cone(v.fan, w)) return T(0);
   return T(1) / v.solid_angle;
+}
+template <class T> T pdf_arvo_triangle_fan(const PolygonLightGeometry<T>& g, const Vec3<T>& w) {
+  return pdf_arvo_triangle_fan(make_arvo_fan_view(g), w);
 }
 
 // ---- Baseline: Turk 1992, "Generating Random Points in Triangles", as published ---------------------------
@@ -463,10 +465,75 @@ template <class T> DirectionSample<T> sample_turk_area(const TurkAreaView<T>& v,
 template <class T> DirectionSample<T> sample_turk_area(const PolygonLightGeometry<T>& g, const Vec2<T>& xi) {
   return sample_turk_area(make_turk_area_view(g), xi);
 }
-template <class T> T pdf_turk_area(const PolygonLightGeometry<T>& g, const Vec3<T>& w) {
-  const TurkAreaView<T> v = make_turk_area_view(g);
+template <class T> T pdf_turk_area(const TurkAreaView<T>& v, const Vec3<T>& w) {
   if (!v.valid() || !all_finite(w) || !in_fan_cone(v.fan, w)) return T(0);
   return turk_density(v, Vec3<T>(w.normalized()));
 }
+template <class T> T pdf_turk_area(const PolygonLightGeometry<T>& g, const Vec3<T>& w) {
+  return pdf_turk_area(make_turk_area_view(g), w);
+}
+
+// ---- Catalogue traits (warpcheck/catalogue.h) ----------------------------------------------------------------
+
+// Kinks in u0 of the fan samplers: the cumulative area fractions of the fan triangles (0, k, k+1), k >= 1.
+template <class T, class View> std::vector<T> polygon_fan_kinks(const View& v) {
+  return v.valid() ? cumulative_area_fractions<T>(v.area.begin() + 1, v.area.begin() + std::max(1, v.fan.count - 1))
+                   : std::vector<T>{};
+}
+
+// A cap containing the fan's vertices: the light, clipped to the horizon if kClipped.
+template <class T, bool kClipped> Cap<T> polygon_fan_bounding_cap(const PolygonLightGeometry<T>& g) {
+  const PolygonFanView<T> f = make_polygon_fan_view(g, kClipped);
+  return f.valid() ? bounding_cap_of_directions(f.p.data(), f.count) : polygon_bounding_cap(g);
+}
+
+// kClipped: only the part of the polygon above the shading horizon.
+template <class T, bool kClipped> struct PolygonSolidAngleKernel {
+  static constexpr const char* name = kClipped ? "polygon-solid-angle-clipped" : "polygon-solid-angle";
+  static constexpr const char* description =
+      kClipped ? "solid angle above the horizon, Peters 2021 Sec. 5" : "solid angle, Peters 2021 Sec. 5";
+  using Scalar = T;
+  using Geometry = PolygonLightGeometry<T>;
+  using View = PolygonSolidAngleView<T>;
+  static View view(const Geometry& g) { return make_polygon_solid_angle_view(g, kClipped); }
+  static DirectionSample<T> sample(const View& v, const Vec2<T>& u) { return sample_polygon_solid_angle(v, u); }
+  static T pdf(const View& v, const Vec3<T>& w) { return pdf_polygon_solid_angle(v, w); }
+  static Cap<T> bounding_cap(const Geometry& g) { return polygon_fan_bounding_cap<T, kClipped>(g); }
+  static T normaliser(const View& v) { return v.solid_angle; }
+  static std::vector<T> kinks_u0(const Geometry& g) { return polygon_fan_kinks<T>(view(g)); }
+  static std::vector<Vec3<T>> boundary_planes(const Geometry& g) { return polygon_boundary_planes(g); }
+};
+template <class T> using PolygonSolidAngle = PolygonSolidAngleKernel<T, false>;
+template <class T> using PolygonSolidAngleClipped = PolygonSolidAngleKernel<T, true>;
+
+template <class T> struct BaselineArvoTriangle {
+  static constexpr const char* name = "baseline-arvo-triangle";
+  static constexpr const char* description = "Arvo 1995 on a triangle fan, as published";
+  using Scalar = T;
+  using Geometry = PolygonLightGeometry<T>;
+  using View = ArvoFanView<T>;
+  static View view(const Geometry& g) { return make_arvo_fan_view(g); }
+  static DirectionSample<T> sample(const View& v, const Vec2<T>& u) { return sample_arvo_triangle_fan(v, u); }
+  static T pdf(const View& v, const Vec3<T>& w) { return pdf_arvo_triangle_fan(v, w); }
+  static Cap<T> bounding_cap(const Geometry& g) { return polygon_fan_bounding_cap<T, false>(g); }
+  static T normaliser(const View& v) { return v.solid_angle; }
+  static std::vector<T> kinks_u0(const Geometry& g) { return polygon_fan_kinks<T>(view(g)); }
+  static std::vector<Vec3<T>> boundary_planes(const Geometry& g) { return polygon_boundary_planes(g); }
+};
+
+template <class T> struct BaselineTurkArea {
+  static constexpr const char* name = "baseline-turk-area";
+  static constexpr const char* description = "uniform in area on a triangle fan, Turk 1992, as published";
+  using Scalar = T;
+  using Geometry = PolygonLightGeometry<T>;
+  using View = TurkAreaView<T>;
+  static View view(const Geometry& g) { return make_turk_area_view(g); }
+  static DirectionSample<T> sample(const View& v, const Vec2<T>& u) { return sample_turk_area(v, u); }
+  static T pdf(const View& v, const Vec3<T>& w) { return pdf_turk_area(v, w); }
+  static Cap<T> bounding_cap(const Geometry& g) { return polygon_fan_bounding_cap<T, false>(g); }
+  static T normaliser(const View& v) { return v.total_area; }  // the light's area
+  static std::vector<T> kinks_u0(const Geometry& g) { return polygon_fan_kinks<T>(view(g)); }
+  static std::vector<Vec3<T>> boundary_planes(const Geometry& g) { return polygon_boundary_planes(g); }
+};
 
 }  // namespace warpcheck

@@ -45,9 +45,11 @@
 //  * pdf is per solid angle: the paper's density p w.r.t. projected solid angle times cos = n.w.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <boost/math/tools/roots.hpp>
 #include <cstdint>
+#include <vector>
 
 #include "warpcheck/core.h"
 #include "warpcheck/sphere.h"
@@ -769,5 +771,53 @@ template <class T> Cap<T> projected_cap_bounding_cap(const ProjectedCapView<T>& 
   c.one_minus_cos = std::min(T(2), omc + std::sqrt(omc * (T(2) - omc)) * delta + delta * delta / T(2));
   return c;
 }
+
+// ---- Catalogue traits (warpcheck/catalogue.h) ----------------------------------------------------------------
+
+// M = kQuintic is the paper's sampler (Alg. 5's quintic); kExact inverts A(X) exactly.
+template <class T, CutDiskInverse M> struct SphereProjectedCapKernel {
+  static constexpr bool kQuintic = M == CutDiskInverse::kQuintic;
+  static constexpr const char* name = kQuintic ? "sphere-projected-cap" : "sphere-projected-cap-exact";
+  static constexpr const char* description = kQuintic
+                                                 ? "projected solid angle, Peters & Dachsbacher 2019 (quintic)"
+                                                 : "projected solid angle, Peters & Dachsbacher 2019 (exact inverse)";
+  using Scalar = T;
+  using Geometry = SphereLightGeometry<T>;
+  using View = ProjectedCapView<T>;
+  static View view(const Geometry& g) { return make_projected_cap_view(g); }
+  static DirectionSample<T> sample(const View& v, const Vec2<T>& u) {
+    return sample_projected_spherical_cap<T, M>(v, u);
+  }
+  static T pdf(const View& v, const Vec3<T>& w) { return pdf_projected_spherical_cap<T, M>(v, w); }
+  static bool invert(const View& v, const Vec3<T>& w, Vec2<T>& u) {
+    return invert_projected_spherical_cap<T, M>(v, w, u);
+  }
+  static Cap<T> bounding_cap(const Geometry& g) {
+    const View v = make_projected_cap_view(g);
+    return v.valid() ? projected_cap_bounding_cap(v) : make_sphere_view(g).cap();
+  }
+  // A_E + A_D: the projected solid angle in Cases 1-2 (Case 3's density is not uniform in the disk).
+  static T normaliser(const View& v) { return v.total; }
+  // Case 2's threshold tau (the warp passes from the ellipse to the disk: continuous, its derivative jumps) and,
+  // for the quintic, the u0 where a piece's left-area passes pi/2 (its density factor depends on min(a, pi - a)).
+  static std::vector<T> kinks_u0(const Geometry& g) {
+    std::vector<T> kinks;
+    const View v = make_projected_cap_view(g);
+    if (!v.valid()) return kinks;
+    if (v.which_case == 2) kinks.push_back(v.tau);
+    if constexpr (kQuintic) {
+      std::array<projected_cap_detail::Piece<T>, 2> ps;
+      const int n = projected_cap_detail::pieces<T, M>(v, ps);
+      for (int i = 0; i < n; ++i) {
+        const T u = (kPi<T> / T(2) - ps[i].alpha) / ps[i].beta;
+        if (u > ps[i].u_lo && u < ps[i].u_hi) kinks.push_back(u);
+      }
+    }
+    std::sort(kinks.begin(), kinks.end());
+    return kinks;
+  }
+};
+template <class T> using SphereProjectedCap = SphereProjectedCapKernel<T, CutDiskInverse::kQuintic>;
+template <class T> using SphereProjectedCapExact = SphereProjectedCapKernel<T, CutDiskInverse::kExact>;
 
 }  // namespace warpcheck

@@ -171,4 +171,36 @@ template <class T> T pdf_sphere_visible_area(const SphereLightGeometry<T>& g, co
   return pdf_sphere_visible_area(make_sphere_view(g), g.light, w);
 }
 
+// ---- Catalogue traits (warpcheck/catalogue.h) ----------------------------------------------------------------
+
+template <class T> struct SphereSolidAngle {
+  static constexpr const char* name = "sphere-solid-angle";
+  static constexpr const char* description = "uniform in the light's cone (Shirley 1996)";
+  using Scalar = T;
+  using Geometry = SphereLightGeometry<T>;
+  using View = SphereView<T>;
+  static View view(const Geometry& g) { return make_sphere_view(g); }
+  static DirectionSample<T> sample(const View& v, const Vec2<T>& u) { return sample_sphere_solid_angle(v, u); }
+  static T pdf(const View& v, const Vec3<T>& w) { return pdf_sphere_solid_angle(v, w); }
+  static Cap<T> bounding_cap(const Geometry& g) { return make_sphere_view(g).cap(); }
+  static T normaliser(const View& v) { return T(1) / sphere_solid_angle_density(v); }  // the cone's solid angle
+};
+
+template <class T> struct SphereVisibleArea {
+  static constexpr const char* name = "sphere-visible-area";
+  static constexpr const char* description = "uniform on the visible cap of the sphere";
+  using Scalar = T;
+  using Geometry = SphereLightGeometry<T>;
+  struct View {
+    SphereView<T> sphere;
+    SphereLight<T> light;
+  };
+  static View view(const Geometry& g) { return {make_sphere_view(g), g.light}; }
+  static DirectionSample<T> sample(const View& v, const Vec2<T>& u) {
+    return sample_sphere_visible_area(v.sphere, v.light, u);
+  }
+  static T pdf(const View& v, const Vec3<T>& w) { return pdf_sphere_visible_area(v.sphere, v.light, w); }
+  static Cap<T> bounding_cap(const Geometry& g) { return make_sphere_view(g).cap(); }
+};
+
 }  // namespace warpcheck

@@ -15,6 +15,7 @@
 #pragma once
 
 #include "warpcheck/polygon.h"
+#include "warpcheck/polygon_solid_angle.h"  // the trait's bounding cap
 
 namespace warpcheck {
 
@@ -113,5 +114,23 @@ template <class T> DirectionSample<T> sample_spherical_rectangle(const PolygonLi
 template <class T> T pdf_spherical_rectangle(const PolygonLightGeometry<T>& g, const Vec3<T>& w) {
   return pdf_spherical_rectangle(make_spherical_rectangle_view(g), w);
 }
+
+// ---- Catalogue trait (warpcheck/catalogue.h) -----------------------------------------------------------------
+
+template <class T> struct BaselineUrenaRectangle {
+  static constexpr const char* name = "baseline-urena-rectangle";
+  static constexpr const char* description = "spherical rectangle, Urena et al. 2013, as published";
+  static constexpr bool rectangles_only = true;
+  using Scalar = T;
+  using Geometry = PolygonLightGeometry<T>;
+  using View = SphericalRectangleView<T>;
+  static View view(const Geometry& g) { return make_spherical_rectangle_view(g); }
+  static DirectionSample<T> sample(const View& v, const Vec2<T>& u) { return sample_spherical_rectangle(v, u); }
+  static T pdf(const View& v, const Vec3<T>& w) { return pdf_spherical_rectangle(v, w); }
+  static Cap<T> bounding_cap(const Geometry& g) { return polygon_fan_bounding_cap<T, false>(g); }
+  static T normaliser(const View& v) { return v.solid_angle; }
+  // One smooth warp (Urena et al. 2013 Sec. 4): no kinks.
+  static std::vector<Vec3<T>> boundary_planes(const Geometry& g) { return polygon_boundary_planes(g); }
+};
 
 }  // namespace warpcheck

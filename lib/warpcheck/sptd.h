@@ -68,6 +68,7 @@
 #include <cstdint>
 #include <limits>
 #include <numbers>
+#include <vector>
 
 #include <boost/math/tools/roots.hpp>
 
@@ -762,5 +763,57 @@ SptdCapGeometry<T> pivot_phase_sphere_light_geometry(const Vec3<T>& wo, T gp, co
   if (!sv.valid()) cap.one_minus_cos = T(0);  // gives "zero size": no sample
   return pivot_phase_geometry(wo, gp, cap);
 }
+
+// ---- Catalogue traits (warpcheck/catalogue.h) ----------------------------------------------------------------
+
+// An SPTD over a cap with base distribution B (Sec. 4.2); the geometry's base is set to B. The pivot phase
+// function (pivot_phase_geometry) and its joint sampling with a sphere light (pivot_phase_sphere_light_geometry)
+// are the uniform kernel on particular geometry.
+template <class T, SptdBase B> struct SptdCapKernel {
+  static constexpr bool kUniform = B == SptdBase::kUniform;
+  static constexpr const char* name = kUniform ? "sptd-uniform-cap" : "sptd-cosine-cap";
+  static constexpr const char* description =
+      kUniform ? "uniform SPTD over a cap, Dupuy et al. 2017" : "clamped-cosine SPTD over a cap, Dupuy et al. 2017";
+  using Scalar = T;
+  using Geometry = SptdCapGeometry<T>;
+  using View = SptdCapView<T>;
+  static View view(const Geometry& g) {
+    Geometry with_base = g;
+    with_base.sptd.base = B;
+    return make_sptd_cap_view(with_base);
+  }
+  static DirectionSample<T> sample(const View& v, const Vec2<T>& u) { return sample_sptd_cap(v, u); }
+  static T pdf(const View& v, const Vec3<T>& w) { return pdf_sptd_cap(v, w); }
+  // The support lies in C.
+  static Cap<T> bounding_cap(const Geometry& g) {
+    Cap<T> c = g.cap;
+    if (!normalize_normal(g.cap.axis, c.axis)) c.axis = Vec3<T>(T(0), T(0), T(1));
+    return c;
+  }
+  static T normaliser(const View& v) { return v.base_integral; }  // the integral of D over C (Eq. 10)
+  // The cosine base near the horizon: x(u0) inverts an area-CDF whose chord length has square-root corners where x
+  // passes the ends of the ellipse E and the horizon abscissa x0; y jumps across E at u1 = 1/2 in the crescent.
+  static std::vector<T> kinks_u0(const Geometry& g) {
+    std::vector<T> kinks;
+    if constexpr (!kUniform) {
+      const View v = view(g);
+      if (v.valid() && !v.cosine.ellipse_only) {
+        const auto& c = v.cosine;
+        for (T x : {c.xc - c.A, c.xc + c.A, c.x0})
+          if (x > T(-1) && x < T(1)) kinks.push_back(c.cdf(x) / c.area);
+      }
+    }
+    return kinks;
+  }
+  static std::vector<T> kinks_u1(const Geometry& g) {
+    if constexpr (!kUniform) {
+      const View v = view(g);
+      if (v.valid() && !v.cosine.ellipse_only) return {T(0.5L)};
+    }
+    return {};
+  }
+};
+template <class T> using SptdUniformCap = SptdCapKernel<T, SptdBase::kUniform>;
+template <class T> using SptdCosineCap = SptdCapKernel<T, SptdBase::kClampedCosine>;
 
 }  // namespace warpcheck
