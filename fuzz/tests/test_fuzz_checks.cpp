@@ -1,4 +1,4 @@
-// Negative controls of the fuzz families that take a Mutation (fuzz/targets/common.h): each family's checks,
+// Negative controls of the fuzz targets that take a Mutation (fuzz/checks/common.h): each target's checks,
 // replayed over its stored corpus with a deliberately broken kernel (a sample pdf 1 % high, the sample direction
 // negated, pdf(direction) 1 % high, the light's normaliser 1 % high), must report an invariant violation on a
 // share of the inputs; unbroken, on none (the fuzz_replay tests assert that too). The share asserted (5 %) is
@@ -13,10 +13,8 @@
 #include <string>
 #include <vector>
 
-#include "targets/common_polygon.h"
-#include "targets/ltc.h"
-#include "targets/projected_cap.h"
-#include "targets/sptd.h"
+#include "checks/polygon.h"
+#include "target_table.h"
 
 namespace warpcheck::fuzz {
 namespace {
@@ -52,19 +50,35 @@ double caught_share(const std::string& target, const Check& check, Mutation::Kin
   return share;
 }
 
+// The targets whose checks take a Mutation.
 struct Family {
-  const char* target;
+  std::string target;
   Check check;
 };
-const Family kFamilies[] = {
-    {"fuzz_projected_cap_double",
-     [](FuzzedDataProvider& in, const Mutation& m) { check_projected_cap<double>(in, m); }},
-    {"fuzz_projected_cap_float", [](FuzzedDataProvider& in, const Mutation& m) { check_projected_cap<float>(in, m); }},
-    {"fuzz_ltc_double", [](FuzzedDataProvider& in, const Mutation& m) { check_ltc<double>(in, m); }},
-    {"fuzz_ltc_float", [](FuzzedDataProvider& in, const Mutation& m) { check_ltc<float>(in, m); }},
-    {"fuzz_sptd_double", [](FuzzedDataProvider& in, const Mutation& m) { check_sptd<double>(in, m); }},
-    {"fuzz_sptd_float", [](FuzzedDataProvider& in, const Mutation& m) { check_sptd<float>(in, m); }},
-};
+template <template <class> class K> void add(std::vector<Family>& v) {
+  v.push_back({std::string("fuzz_") + K<double>::name + "_double",
+               [](FuzzedDataProvider& in, const Mutation& m) { FuzzTarget<K>::template check<double>(in, m); }});
+  v.push_back({std::string("fuzz_") + K<double>::name + "_float",
+               [](FuzzedDataProvider& in, const Mutation& m) { FuzzTarget<K>::template check<float>(in, m); }});
+}
+const std::vector<Family> kFamilies = [] {
+  std::vector<Family> v;
+  add<SphereProjectedCap>(v);
+  add<SphereProjectedCapExact>(v);
+  add<PolygonLtc>(v);
+  add<SptdUniformCap>(v);
+  add<SptdCosineCap>(v);
+  return v;
+}();
+
+// The fuzz targets are exactly the catalogue's kernels, each in float and double, named after them.
+TEST(FuzzTargets, AreTheCatalogueKernelsInFloatAndDouble) {
+  const auto targets = fuzz_targets();
+  EXPECT_EQ(targets.size(), 2 * AllKernels::size);
+  for (std::string_view kernel : AllKernels::names())
+    for (const char* scalar : {"_float", "_double"})
+      EXPECT_EQ(targets.count("fuzz_" + std::string(kernel) + scalar), 1u) << kernel << scalar;
+}
 
 TEST(FuzzChecks, UnbrokenKernelsPassOnTheirCorpora) {
   for (const Family& f : kFamilies) EXPECT_EQ(caught_share(f.target, f.check, Mutation::kNone), 0) << f.target;
@@ -76,7 +90,7 @@ TEST(FuzzChecks, UnbrokenKernelsPassOnTheirCorpora) {
 // normaliser is part of the reference density the sample pdf is compared with, which the pdf mutations cover).
 TEST(FuzzChecks, EachCheckCatchesABrokenKernelOnAtLeastOneInputInTwenty) {
   for (const Family& f : kFamilies) {
-    const bool sptd = std::string(f.target).find("sptd") != std::string::npos;
+    const bool sptd = f.target.find("sptd") != std::string::npos;
     for (auto k : {Mutation::kSamplePdfTimes1_01, Mutation::kSampleDirectionNegated, Mutation::kPdfTimes1_01,
                    Mutation::kNormaliserTimes1_01}) {
       if (sptd && k == Mutation::kNormaliserTimes1_01) continue;
@@ -91,7 +105,7 @@ TEST(FuzzChecks, EachCheckCatchesABrokenKernelOnAtLeastOneInputInTwenty) {
 // vertex.
 TEST(FuzzChecks, TheLtcVertexCheckCatchesATransformedVertexTurnedBy1e3RadOnAtLeastOneInputInTwenty) {
   for (const Family& f : kFamilies) {
-    if (std::string(f.target).find("ltc") == std::string::npos) continue;
+    if (f.target.find("ltc") == std::string::npos) continue;
     EXPECT_GE(caught_share(f.target, f.check, Mutation::kTransformedVertexTurned), 0.05) << f.target;
   }
 }
