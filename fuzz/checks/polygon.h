@@ -4,6 +4,8 @@
 #pragma once
 
 #include "common.h"
+#include "warpcheck/polygon_projected.h"
+#include "warpcheck/polygon_solid_angle.h"
 
 namespace warpcheck::fuzz {
 
@@ -379,6 +381,37 @@ void check_polygon_kernel(FuzzedDataProvider& in, const PolygonLightGeometry<T>&
       WARPCHECK_FUZZ_REQUIRE(p == T(0), "pdf > 0 outside the polygon",
                              geo << "pdf " << p << " margin " << margin << " tol " << tol << "\n");
   }
+}
+
+// Projected-solid-angle sampling, Peters 2021 Sec. 3 (0 to 4 tangent-line iterations; the catalogue's
+// configuration has 2) or its biased variant of Sec. 6.4; samples lie in the polygon clipped to the shading
+// horizon. The byte after the geometry chose the variant when one target checked both: it is read and ignored, so
+// that the stored inputs decode as they did.
+template <class T, bool kBiased> void check_polygon_projected(FuzzedDataProvider& in) {
+  const PolygonLightGeometry<T> g = decode_polygon_geometry<T>(in);
+  (void)in.ConsumeIntegralInRange<int>(0, 3);
+  int iterations = 0;
+  if (!kBiased) iterations = in.ConsumeIntegralInRange<int>(0, 4);
+  const PolygonProjectedView<T> v = make_polygon_projected_view<T, kBiased>(g);
+  check_polygon_kernel<T>(
+      in, g, PolygonProjectedSolidAngleKernel<T, kBiased>::name, true, PolygonDensity::kCosine,
+      [&](const Vec2<T>& u) { return sample_polygon_projected_solid_angle<T, kBiased>(v, u, iterations); },
+      [&](const Vec3<T>& w) {
+        return kBiased ? pdf_polygon_projected_solid_angle(v, w) : pdf_polygon_projected_solid_angle(g, w);
+      });
+}
+
+// Solid-angle sampling, Peters 2021 Sec. 5, of the whole polygon or clipped to the shading horizon. The byte after
+// the geometry chose whether to clip when one target checked both: it is read and ignored, so that the stored
+// inputs decode as they did.
+template <class T, bool kClipped> void check_polygon_solid_angle(FuzzedDataProvider& in) {
+  const PolygonLightGeometry<T> g = decode_polygon_geometry<T>(in);
+  (void)in.ConsumeBool();
+  const PolygonSolidAngleView<T> v = make_polygon_solid_angle_view(g, kClipped);
+  check_polygon_kernel<T>(
+      in, g, PolygonSolidAngleKernel<T, kClipped>::name, kClipped, PolygonDensity::kConstant,
+      [&](const Vec2<T>& u) { return sample_polygon_solid_angle(v, u); },
+      [&](const Vec3<T>& w) { return pdf_polygon_solid_angle(g, w, kClipped); });
 }
 
 }  // namespace warpcheck::fuzz
