@@ -2,6 +2,9 @@
 // between two directions, a cap's half-angle, and the projected solid angle of a cap by quadrature.
 #pragma once
 
+#include <algorithm>
+#include <vector>
+
 #include <boost/math/quadrature/tanh_sinh.hpp>
 
 #include "common.h"
@@ -62,12 +65,12 @@ inline Quadrature reference_cap_projected_solid_angle(L t, L psi) {
   // 10 refinements: a piece that has not converged by then reports its error estimate, which the callers add
   // to their tolerance, instead of recursing (a piece of width ~1e-19 next to a kink never converges).
   static boost::math::quadrature::tanh_sinh<L> ts(10);
-  L cuts[6] = {0};
-  int n = 1;
+  std::vector<L> cuts = {0};  // the ends and the kinks between them
   for (L k : {kPi<L> / 2 - t, 3 * kPi<L> / 2 - t, t - kPi<L> / 2, t + kPi<L> / 2})
-    if (k > psi * L(1e-12) && k < psi * (1 - L(1e-12))) cuts[n++] = k;  // kinks this close to an end: not split
-  cuts[n++] = psi;
-  std::sort(cuts, cuts + n);
+    if (k > psi * L(1e-12) && k < psi * (1 - L(1e-12))) cuts.push_back(k);  // kinks this close to an end: not split
+  cuts.push_back(psi);
+  std::sort(cuts.begin(), cuts.end());
+  const int n = int(cuts.size());
   auto f = [t](L theta) { return std::sin(theta) * ring_cosine_integral(theta, t); };
   for (int i = 0; i + 1 < n; ++i) {
     const L a = cuts[i], b = cuts[i + 1];

@@ -7,6 +7,7 @@
 // sphere.h's decoder). Degeneracies: |r_p| = 1 - 2^-k up to and beyond rounding to 1, raw pivots (|r_p| >= 1:
 // no pivot), caps containing the pivot direction, with their boundary through it (tangent), opposite to it, the
 // whole sphere and 2 - tiny, tiny caps, 1 - cos <= 0, NaN / Inf anywhere.
+// The target of sptd-uniform-cap takes all three ways in, that of sptd-cosine-cap the general cap (decode_sptd).
 //
 // The kernel's sample pdf IS its pdf(direction) (sample_sptd_cap calls pdf_sptd_cap), so comparing the two would
 // be a test that cannot fail. Instead both are compared with an independent long double reference of the

@@ -99,7 +99,7 @@ TEST(FuzzChecks, EachCheckCatchesABrokenKernelOnAtLeastOneInputInTwenty) {
   }
 }
 
-// The LTC family's check of the kernel's M^-1 P vertex by vertex (fuzz/targets/ltc.h) against every vertex turned
+// The LTC family's check of the kernel's M^-1 P vertex by vertex (fuzz/checks/ltc.h) against every vertex turned
 // by 1e-3 rad, which the normaliser check alone may not see (a turn along the light's boundary changes A_Sigma by
 // less than 1 %). About a third of the corpus inputs catch it; the rest are invalid or have no well-conditioned
 // vertex.
@@ -110,7 +110,7 @@ TEST(FuzzChecks, TheLtcVertexCheckCatchesATransformedVertexTurnedBy1e3RadOnAtLea
   }
 }
 
-// Negative controls of polygon_margins' relaxations (fuzz/targets/common_polygon.h). Each relaxation accepts an
+// Negative controls of polygon_margins' relaxations (fuzz/checks/polygon.h). Each relaxation accepts an
 // accepted displacement of the light (a merged flat light, the flattened light with its credit); on lights that
 // need them, the check must still reject a direction a little way outside the light (outer below -theta / 2).
 // theta is about 100 times the larger of the tolerance and the relaxation's credit. `inner` (the excuse for a
