@@ -7,12 +7,12 @@ usage() {
 usage: fuzz/campaign.sh [--minutes M] [--jobs J] [--targets GLOB] [--build DIR] [--max-len N]
                         [--max-artifacts K]
 
-Runs each libFuzzer target whose name matches GLOB (default 'fuzz_*'; e.g. 'fuzz_*_double' or
-'fuzz_sphere_double') one after the other, each for M minutes (default 1) with libFuzzer's fork mode on J
-worker processes (default 1), from the seed corpus data/fuzz/TARGET/corpus and the dictionary
+Runs each libFuzzer target (fuzz_<catalogue kernel>_<scalar>) whose name matches GLOB (default 'fuzz_*';
+e.g. 'fuzz_*_double' or 'fuzz_sphere-solid-angle_double') one after the other, each for M minutes (default 1)
+with libFuzzer's fork mode on J worker processes (default 1), from the seed corpus data/fuzz/TARGET/corpus and the dictionary
 data/fuzz/TARGET/dict when present. The targets must already be built in DIR (default build-fuzz):
   CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=Release -DWARPCHECK_BUILD_FUZZERS=ON
-  ninja -C build-fuzz -j1 $(ninja -C build-fuzz -t targets all | grep -o '^fuzz_[a-z_]*_\(float\|double\)' | sort -u)
+  ninja -C build-fuzz -j1 $(ninja -C build-fuzz -t targets all | grep -o '^fuzz_[a-z0-9-]*_\(float\|double\)' | sort -u)
 
 Per target, afterwards:
   - new inputs are merged into data/fuzz/TARGET/corpus with -merge=1 (only those that add coverage);
@@ -78,7 +78,7 @@ signature() {
   sig="$(grep -m1 -o 'warpcheck invariant violated: .*' "$out" | sed -e 's|\[[^]]*/\([^/]*:[0-9]*\)\]|[\1]|' || true)"
   if [[ -n "$sig" ]]; then
     local kernel
-    kernel="$(grep -m1 -A1 'warpcheck invariant violated' "$out" | tail -n1 | grep -o '^[a-z_]* <[a-z]*>' || true)"
+    kernel="$(grep -m1 -A1 'warpcheck invariant violated' "$out" | tail -n1 | grep -o '^[a-z0-9_-]* <[a-z]*>' || true)"
     echo "$kernel: ${sig#warpcheck invariant violated: }"
     return
   fi

@@ -1,5 +1,5 @@
-// fuzz/entry.h: the libFuzzer entry point of one target. CMake generates one source per target that includes
-// the family header and this file and says WARPCHECK_FUZZ_ENTRY(warpcheck::fuzz::check_<family><T>).
+// fuzz/entry.h: the libFuzzer entry point of one target. CMake generates one source per target that includes the
+// target header and this file and says WARPCHECK_FUZZ_ENTRY(warpcheck::fuzz::FuzzTarget<warpcheck::Trait>::check<T>).
 //
 // An InvariantViolation is printed and turned into abort(), which libFuzzer reports as a crash with the
 // input saved. With -DWARPCHECK_FUZZ_TRAP_FP=ON, FE_INVALID traps (SIGFPE at the instruction that makes the

@@ -1,9 +1,9 @@
-// Negative controls of the fuzz families that take a Mutation (fuzz/targets/common.h): each family's checks,
+// Negative controls of the fuzz targets that take a Mutation (fuzz/checks/common.h): each target's checks,
 // replayed over its stored corpus with a deliberately broken kernel (a sample pdf 1 % high, the sample direction
 // negated, pdf(direction) 1 % high, the light's normaliser 1 % high), must report an invariant violation on a
 // share of the inputs; unbroken, on none (the fuzz_replay tests assert that too). The share asserted (5 %) is
-// below the ones measured when the corpora were stored (table below; printed by each test), so that a corpus
-// re-merged by a campaign keeps passing while a check that lost its teeth does not.
+// well below the shares the stored corpora give (printed by each test; fuzz/README.md lists them), so that a
+// corpus re-merged by a campaign keeps passing while a check that lost its teeth does not.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -13,10 +13,8 @@
 #include <string>
 #include <vector>
 
-#include "targets/common_polygon.h"
-#include "targets/ltc.h"
-#include "targets/projected_cap.h"
-#include "targets/sptd.h"
+#include "checks/polygon.h"
+#include "target_table.h"
 
 namespace warpcheck::fuzz {
 namespace {
@@ -52,39 +50,47 @@ double caught_share(const std::string& target, const Check& check, Mutation::Kin
   return share;
 }
 
+// The targets whose checks take a Mutation.
 struct Family {
-  const char* target;
+  std::string target;
   Check check;
 };
-const Family kFamilies[] = {
-    {"fuzz_projected_cap_double",
-     [](FuzzedDataProvider& in, const Mutation& m) { check_projected_cap<double>(in, m); }},
-    {"fuzz_projected_cap_float", [](FuzzedDataProvider& in, const Mutation& m) { check_projected_cap<float>(in, m); }},
-    {"fuzz_ltc_double", [](FuzzedDataProvider& in, const Mutation& m) { check_ltc<double>(in, m); }},
-    {"fuzz_ltc_float", [](FuzzedDataProvider& in, const Mutation& m) { check_ltc<float>(in, m); }},
-    {"fuzz_sptd_double", [](FuzzedDataProvider& in, const Mutation& m) { check_sptd<double>(in, m); }},
-    {"fuzz_sptd_float", [](FuzzedDataProvider& in, const Mutation& m) { check_sptd<float>(in, m); }},
-};
+template <template <class> class K> void add(std::vector<Family>& v) {
+  v.push_back({std::string("fuzz_") + K<double>::name + "_double",
+               [](FuzzedDataProvider& in, const Mutation& m) { FuzzTarget<K>::template check<double>(in, m); }});
+  v.push_back({std::string("fuzz_") + K<double>::name + "_float",
+               [](FuzzedDataProvider& in, const Mutation& m) { FuzzTarget<K>::template check<float>(in, m); }});
+}
+const std::vector<Family> kFamilies = [] {
+  std::vector<Family> v;
+  add<SphereProjectedCap>(v);
+  add<SphereProjectedCapExact>(v);
+  add<PolygonLtc>(v);
+  add<SptdUniformCap>(v);
+  add<SptdCosineCap>(v);
+  return v;
+}();
+
+// The fuzz targets are exactly the catalogue's kernels, each in float and double, named after them.
+TEST(FuzzTargets, AreTheCatalogueKernelsInFloatAndDouble) {
+  const auto targets = fuzz_targets();
+  EXPECT_EQ(targets.size(), 2 * AllKernels::size);
+  for (std::string_view kernel : AllKernels::names())
+    for (const char* scalar : {"_float", "_double"})
+      EXPECT_EQ(targets.count("fuzz_" + std::string(kernel) + scalar), 1u) << kernel << scalar;
+}
 
 TEST(FuzzChecks, UnbrokenKernelsPassOnTheirCorpora) {
   for (const Family& f : kFamilies) EXPECT_EQ(caught_share(f.target, f.check, Mutation::kNone), 0) << f.target;
 }
 
-// Measured when the corpora were stored (build/fuzz/warpcheck_fuzz_tests prints them; 2026-12-01), share of the
-// corpus caught:                   sample pdf x1.01   direction negated   pdf(direction) x1.01   normaliser x1.01
-//   fuzz_projected_cap_double      0.168              0.412               0.168                  0.248
-//   fuzz_projected_cap_float       0.191              0.395               0.191                  0.214
-//   fuzz_ltc_double                0.150              0.150               0.150                  0.132
-//   fuzz_ltc_float                 0.092              0.286               0.092                  0.148
-//   fuzz_sptd_double               0.257              0.246               0.251                  -
-//   fuzz_sptd_float                0.196              0.214               0.186                  -
 // Most of a corpus is degenerate on purpose (invalid lights, samples on the boundary, where a 1 % change of the
 // density is within its own variation): the shares are not the fuzzer's hit rate on a broken kernel, they show
 // that each check still bites. Required: one input in twenty. SPTD has no view-level normaliser check (its
 // normaliser is part of the reference density the sample pdf is compared with, which the pdf mutations cover).
 TEST(FuzzChecks, EachCheckCatchesABrokenKernelOnAtLeastOneInputInTwenty) {
   for (const Family& f : kFamilies) {
-    const bool sptd = std::string(f.target).find("sptd") != std::string::npos;
+    const bool sptd = f.target.find("sptd") != std::string::npos;
     for (auto k : {Mutation::kSamplePdfTimes1_01, Mutation::kSampleDirectionNegated, Mutation::kPdfTimes1_01,
                    Mutation::kNormaliserTimes1_01}) {
       if (sptd && k == Mutation::kNormaliserTimes1_01) continue;
@@ -93,28 +99,26 @@ TEST(FuzzChecks, EachCheckCatchesABrokenKernelOnAtLeastOneInputInTwenty) {
   }
 }
 
-// The LTC family's check of the kernel's M^-1 P vertex by vertex (fuzz/targets/ltc.h) against every vertex turned
+// The LTC family's check of the kernel's M^-1 P vertex by vertex (fuzz/checks/ltc.h) against every vertex turned
 // by 1e-3 rad, which the normaliser check alone may not see (a turn along the light's boundary changes A_Sigma by
-// less than 1 %). Measured when it was added (2026-12-03, build/fuzz/warpcheck_fuzz_tests): caught on 303 of 891
-// double and 231 of 796 float corpus inputs (0.340, 0.290); the rest are invalid or have no well-conditioned vertex.
+// less than 1 %). About a third of the corpus inputs catch it; the rest are invalid or have no well-conditioned
+// vertex.
 TEST(FuzzChecks, TheLtcVertexCheckCatchesATransformedVertexTurnedBy1e3RadOnAtLeastOneInputInTwenty) {
   for (const Family& f : kFamilies) {
-    if (std::string(f.target).find("ltc") == std::string::npos) continue;
+    if (f.target.find("ltc") == std::string::npos) continue;
     EXPECT_GE(caught_share(f.target, f.check, Mutation::kTransformedVertexTurned), 0.05) << f.target;
   }
 }
 
-// Negative controls of polygon_margins' relaxations (fuzz/targets/common_polygon.h). Each relaxation accepts an
-// accepted displacement of the light (a merged flat light, the flattened light with its credit), found by a
-// false positive; this shows that on the very inputs that needed them the check still rejects a direction a
-// little way outside the light (outer below -theta / 2). theta is about 100 times the larger of the tolerance and
-// the relaxation's credit, from the triages: 4a059601 has no credit (its delta/2 branch; tol 1.4e-14), e9b7708c
-// a credit of 3.7e-12 rad. `inner` (the excuse for a density of 0) is the minimum over the accepted
-// displacements, the light as given among them, so it has no lower bound to test on lights non-convex as seen
-// from x. Not controlled, and cannot be: 80cce1ce (ltc_double), where x is 0.31 above a light 4.4e12 wide that is
-// non-planar by 0.31 with x's foot inside it; its credit, off / height, is ~1 rad and exceeds pi/2, so every
-// direction is accepted (measured: outer +0.0055 for the direction straight away from the light's plane). Such
-// a light is planar within check_polygon's tolerance, and which side of it x lies on is not determined.
+// Negative controls of polygon_margins' relaxations (fuzz/checks/polygon.h). Each relaxation accepts an
+// accepted displacement of the light (a merged flat light, the flattened light with its credit); on lights that
+// need them, the check must still reject a direction a little way outside the light (outer below -theta / 2).
+// theta is about 100 times the larger of the tolerance and the relaxation's credit. `inner` (the excuse for a
+// density of 0) is the minimum over the accepted displacements, the light as given among them, so it has no lower
+// bound to test on lights non-convex as seen from x. Not controlled, and cannot be: a light non-planar by more than
+// x's height above it with x's foot inside it (e.g. 0.31 above a light 4.4e12 wide that is non-planar by 0.31), whose
+// credit off / height exceeds pi/2, so that every direction is accepted. Such a light is planar within
+// check_polygon's tolerance, and which side of it x lies on is not determined.
 struct MarginCase {
   const char* name;
   Vec3<double> v[4];
@@ -133,7 +137,7 @@ PolygonLightGeometry<double> margin_case_geometry(const MarginCase& c) {
 
 TEST(FuzzChecks, PolygonMarginsRelaxationsStillRejectDirectionsOutsideTheLightByAHundredTimesTheirCredit) {
   const MarginCase cases[] = {
-      {"4a059601 (polygon_solid_angle_double)",
+      {"an edge along the normal of a light non-planar within delta / 2 (no credit)",
        {{-5.8205884556628007e-11, 5.4736550784744359e-48, 0},
         {0, -15.99951171875, -15.87695686519146},
         {5.8205884556628007e-11, 5.4736550784744359e-48, -1},
@@ -142,7 +146,7 @@ TEST(FuzzChecks, PolygonMarginsRelaxationsStillRejectDirectionsOutsideTheLightBy
        {-4, -4.9406564584124654e-324, 3},
        true,
        1e-12},
-      {"e9b7708c (polygon_solid_angle_double)",
+      {"a vertex off the plane within the planarity tolerance (credit 3.7e-12 rad)",
        {{3.96923828125, -1.4551915228366852e-11, 0}, {0, 0, -0.0}, {-4, 0, 0}, {2, -0.0, 3.96923828125}},
        {0, 1, -3.057789944907e-33},
        {0.93463450179615559, 0.13277316173762499, -0.32989337000680469},
