@@ -136,7 +136,7 @@ std::string cell_class(const Result& r) {
 }
 std::string cell_value(const Result& r) {
   if (r.p_value) return "p=" + num(*r.p_value);
-  return r.statistic ? num(*r.statistic) : "error";
+  return std::isnan(r.statistic) ? "error" : num(r.statistic);
 }
 
 std::string not_run(const std::string& what, const std::string& command) {
@@ -758,8 +758,9 @@ ReportSummary write_report(const ReportOptions& opt) {
       configs.insert(r->config);
       p << "<tr id=\"" << result_anchor(*r) << "\"><td>" << html_escape(r->scalar) << "</td><td>"
         << html_escape(r->config) << "</td><td>" << html_escape(r->test) << "</td><td>"
-        << (r->statistic ? num(*r->statistic, 6) : "null") << "</td><td>" << (r->p_value ? num(*r->p_value, 4) : "-")
-        << "</td><td class=\"" << cell_class(*r) << "\">" << verdict(*r) << "</td><td>" << html_escape(r->detail)
+        << (std::isnan(r->statistic) ? "null" : num(r->statistic, 6)) << "</td><td>"
+        << (r->p_value ? num(*r->p_value, 4) : "-") << "</td><td class=\"" << cell_class(*r) << "\">" << verdict(*r)
+        << "</td><td>" << html_escape(r->detail)
         << (r->known_limitation.empty() ? "" : "<br><i>known limitation: " + html_escape(r->known_limitation) + "</i>")
         << (r->map_rows ? " <a href=\"#maps-" + result_anchor(*r) + "\">maps</a>" : "") << "</td></tr>";
     }
@@ -784,7 +785,7 @@ ReportSummary write_report(const ReportOptions& opt) {
   std::ostringstream x;
   x << page_start("warpcheck report") << "<h1>warpcheck validation report</h1>\n";
   x << "<p>Results: <code>" << html_escape(opt.results_path) << "</code>; significance alpha = " << num(run.alpha)
-    << " family-wise, " << html_escape(run.correction) << " correction across " << run.statistical_tests
+    << " family-wise, " << to_string(run.correction) << " correction across " << run.statistical_tests()
     << " statistical tests" << (run.samples ? "; " + std::to_string(*run.samples) + " samples per case" : "")
     << (run.seed ? "; seed " + std::to_string(*run.seed) : "") << ".</p>\n";
   if (run.complete && !*run.complete)
@@ -806,7 +807,7 @@ ReportSummary write_report(const ReportOptions& opt) {
       x << "<li><a href=\"" << kernel_page(r->kernel) << "#" << result_anchor(*r) << "\">" << html_escape(r->kernel)
         << " / " << html_escape(r->scalar) << " / " << html_escape(r->config) << ": " << html_escape(r->test) << "</a> "
         << (r->p_value ? "p = " + num(*r->p_value)
-                       : "statistic " + (r->statistic ? num(*r->statistic) : std::string("null")))
+                       : "statistic " + (std::isnan(r->statistic) ? std::string("null") : num(r->statistic)))
         << " <span class=\"muted\">" << html_escape(r->detail) << "</span>"
         << (r->map_rows
                 ? " <a href=\"" + kernel_page(r->kernel) + "#maps-" + result_anchor(*r) + "\">(residual map)</a>"

@@ -2,7 +2,6 @@
 // chi-square bins and KS marginals, the deterministic tests), then draws and runs the statistical tests per
 // seed. The tests themselves are in statistical_tests.cpp and deterministic_tests.cpp.
 #include <algorithm>
-#include <cmath>
 #include <cstdio>
 #include <sstream>
 #include <stdexcept>
@@ -21,30 +20,6 @@ std::string format_g(double v, int prec) {
 }
 
 namespace {
-
-std::string json_escape(const std::string& s) {
-  std::string o;
-  for (char c : s) {
-    if (c == '"' || c == '\\')
-      o += '\\', o += c;
-    else if (static_cast<unsigned char>(c) < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", c);
-      o += buf;
-    } else
-      o += c;
-  }
-  return o;
-}
-
-// JSON has no infinity; 1e999 is a valid JSON number that parsers read as +Infinity.
-std::string json_number(double v) {
-  if (std::isnan(v)) return "null";
-  if (std::isinf(v)) return v > 0 ? "1e999" : "-1e999";
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
 
 // Validates the options and the sampler; returns the options the battery really uses.
 BatteryOptions checked_options(const SamplerUnderTest& s, const BatteryOptions& options) {
@@ -95,8 +70,6 @@ std::vector<TestResult> run_seed(const SamplerUnderTest& s, const BatteryOptions
 
 using namespace battery;
 
-const char* to_string(Correction c) { return c == Correction::kSidak ? "sidak" : "holm"; }
-
 std::vector<TestResult> run_battery(const SamplerUnderTest& s, const BatteryOptions& options) {
   return run_battery_seeds(s, options, {options.seed}).front();
 }
@@ -135,39 +108,6 @@ std::string format_table(const std::vector<TestResult>& results) {
                   r.passed ? "pass" : (r.known_limitation.empty() ? "FAIL" : "fail (known limitation)"));
     o << line;
   }
-  return o.str();
-}
-
-std::string to_json(const std::vector<TestResult>& results, double alpha, Correction c,
-                    const std::string& extra_members) {
-  std::size_t m = 0;
-  for (const auto& r : results) m += r.p_value.has_value();
-  std::ostringstream o;
-  o << "{\"alpha\":" << json_number(alpha) << ",\"correction\":\"" << to_string(c) << "\",\"statistical_tests\":" << m
-    << (extra_members.empty() ? "" : ",") << extra_members << ",\"results\":[";
-  for (std::size_t i = 0; i < results.size(); ++i) {
-    const auto& r = results[i];
-    o << (i ? ",\n" : "\n") << "{\"kernel\":\"" << json_escape(r.kernel) << "\",\"scalar\":\"" << json_escape(r.scalar)
-      << "\",\"config\":\"" << json_escape(r.config) << "\",\"test\":\"" << json_escape(r.test)
-      << "\",\"statistic\":" << json_number(r.statistic)
-      << ",\"p_value\":" << (r.p_value ? json_number(*r.p_value) : "null")
-      << ",\"passed\":" << (r.passed ? "true" : "false") << ",\"detail\":\"" << json_escape(r.detail) << "\"";
-    if (!r.known_limitation.empty()) o << ",\"known_limitation\":\"" << json_escape(r.known_limitation) << "\"";
-    if (r.map_rows > 0) {
-      // Expected counts to 9 significant digits: enough for residual maps, a third of the bytes of %.17g.
-      char buf[32];
-      o << ",\"map\":{\"rows\":" << r.map_rows << ",\"cols\":" << r.map_cols << ",\"observed\":[";
-      for (std::size_t k = 0; k < r.observed.size(); ++k) o << (k ? "," : "") << std::uint64_t(r.observed[k]);
-      o << "],\"expected\":[";
-      for (std::size_t k = 0; k < r.expected.size(); ++k) {
-        std::snprintf(buf, sizeof buf, "%.9g", r.expected[k]);
-        o << (k ? "," : "") << buf;
-      }
-      o << "]}";
-    }
-    o << "}";
-  }
-  o << "\n]}\n";
   return o.str();
 }
 

@@ -27,8 +27,7 @@ std::size_t apply_correction(std::vector<TestResult>& results, double alpha, Cor
 }
 
 bool all_passed(const std::vector<TestResult>& results) {
-  return std::all_of(results.begin(), results.end(),
-                     [](const TestResult& r) { return r.passed || !r.known_limitation.empty(); });
+  return std::none_of(results.begin(), results.end(), [](const TestResult& r) { return r.failed(); });
 }
 
 }  // namespace warpcheck::validation
