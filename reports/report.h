@@ -1,7 +1,7 @@
-// warpcheck/validation/report.h: the HTML report (`warpcheck report`, issue 8).
+// reports/report.h: the HTML report (`warpcheck report`).
 //
-// write_report() turns a battery results JSON (`warpcheck validate --json`, battery.h to_json) and whatever
-// the data directory holds (claims, worst cases, fuzz summary, benchmarks) into a static, offline site:
+// write_report() turns a battery results JSON (`warpcheck validate --json`, results.h) and whatever
+// the data directory holds (claims, geometry maps, worst cases, fuzz summary, benchmarks) into a static, offline site:
 //   index.html        pass/fail matrix (kernel x scalar x config by test), the failing list first, alpha and
 //                     correction; then the data sections (claims beside the paper, worst cases, fuzz, bench)
 //   kernel-<k>.html   one page per kernel: its results, per chi2 test the observed / expected / signed
@@ -20,37 +20,10 @@
 #include <utility>
 #include <vector>
 
+#include "warpcheck/validation/results.h"
 #include "warpcheck/validation/sampler.h"
 
 namespace warpcheck::validation::report {
-
-// ---- Model: the battery results JSON ------------------------------------------------------------------------
-
-struct Result {
-  std::string kernel, scalar, config, test;
-  std::optional<double> statistic;  // null in the JSON when NaN (e.g. a battery that threw)
-  std::optional<double> p_value;    // null for deterministic tests
-  bool passed = false;
-  std::string detail, known_limitation;
-  int map_rows = 0, map_cols = 0;  // chi2 only: the grid over the bounding cap (battery.h TestResult)
-  std::vector<double> observed, expected;
-
-  // Failed and not a documented limitation: this fails the run.
-  bool failed() const { return !passed && known_limitation.empty(); }
-};
-
-struct BatteryRun {
-  double alpha = 0;
-  std::string correction;
-  long long statistical_tests = 0;
-  std::optional<long long> samples, seed;
-  std::optional<bool> complete;
-  std::vector<Result> results;
-};
-
-// Parses the JSON text written by battery.h to_json (with the CLI's extra members). Throws std::runtime_error
-// naming the first missing or mistyped member.
-BatteryRun parse_battery_json(const std::string& text);
 
 // ---- Images ----------------------------------------------------------------------------------------------------
 

@@ -120,21 +120,21 @@ std::string page_start(const std::string& title) {
 std::string page_end() { return "<pre id=\"wc-load-check\" hidden>LOADCHECK pending</pre>\n</body></html>\n"; }
 
 std::string kernel_page(const std::string& kernel) { return "kernel-" + safe_name(kernel) + ".html"; }
-std::string result_anchor(const Result& r) {
+std::string result_anchor(const TestResult& r) {
   return "r-" + safe_name(r.scalar) + "-" + safe_name(r.config) + "-" + safe_name(r.test);
 }
 
-std::string verdict(const Result& r) {
+std::string verdict(const TestResult& r) {
   if (r.passed) return r.known_limitation.empty() ? "pass" : "pass (known limitation case)";
   return r.known_limitation.empty() ? "FAIL" : "fail (known limitation)";
 }
-std::string cell_class(const Result& r) {
+std::string cell_class(const TestResult& r) {
   if (r.passed) return r.known_limitation.empty() ? "pass" : "knownpass";
   return r.known_limitation.empty() ? "fail" : "known";
 }
-std::string cell_value(const Result& r) {
+std::string cell_value(const TestResult& r) {
   if (r.p_value) return "p=" + num(*r.p_value);
-  return r.statistic ? num(*r.statistic) : "error";
+  return std::isnan(r.statistic) ? "error" : num(r.statistic);
 }
 
 std::string not_run(const std::string& what, const std::string& command) {
@@ -201,7 +201,7 @@ struct Residuals {
   double off_o = 0, off_e = 0;
 };
 
-Residuals residuals(const Result& r, std::optional<long long> samples) {
+Residuals residuals(const TestResult& r, std::optional<long long> samples) {
   const std::size_t n = std::size_t(r.map_rows) * r.map_cols;
   const double inf = std::numeric_limits<double>::infinity();
   Residuals s;
@@ -232,7 +232,7 @@ Residuals residuals(const Result& r, std::optional<long long> samples) {
 }
 
 // Bar charts of the residuals of the grid's marginals, per radial row and per azimuth column.
-std::string marginal_figures(const Result& r) {
+std::string marginal_figures(const TestResult& r) {
   const int R = r.map_rows, A = r.map_cols;
   std::vector<double> ro(R, 0), re(R, 0), ao(A, 0), ae(A, 0), rr(R), ar(A);
   for (int i = 0; i < R; ++i)
@@ -251,7 +251,7 @@ std::string marginal_figures(const Result& r) {
 }
 
 // Writes the PNGs and the EXR of one chi2 result; returns the HTML figure block.
-std::string chi2_maps(const Result& r, std::optional<long long> samples, const fs::path& out, ReportSummary& sum) {
+std::string chi2_maps(const TestResult& r, std::optional<long long> samples, const fs::path& out, ReportSummary& sum) {
   const int R = r.map_rows, A = r.map_cols;
   const Residuals s = residuals(r, samples);
   // Residual scale: at least +-4 so that noise (|r| ~ 1) stays pale and a failure saturates.
@@ -796,12 +796,12 @@ std::string geometry_maps_section(const fs::path& data) {
 // The results grouped by kernel, kernels and tests in order of first appearance.
 struct Grouped {
   std::vector<std::string> kernels, tests;
-  std::map<std::string, std::vector<const Result*>> by_kernel;
+  std::map<std::string, std::vector<const TestResult*>> by_kernel;
 };
 
 Grouped group(const BatteryRun& run, ReportSummary& sum) {
   Grouped g;
-  for (const Result& r : run.results) {
+  for (const TestResult& r : run.results) {
     if (!g.by_kernel.count(r.kernel)) g.kernels.push_back(r.kernel);
     g.by_kernel[r.kernel].push_back(&r);
     if (std::find(g.tests.begin(), g.tests.end(), r.test) == g.tests.end()) g.tests.push_back(r.test);
@@ -820,45 +820,46 @@ struct SampleSources {
   std::vector<std::array<double, 2>> blue;
 };
 
-std::string results_table(const std::vector<const Result*>& rs) {
+std::string results_table(const std::vector<const TestResult*>& rs) {
   std::ostringstream p;
   p << "<h2>Results</h2><table><tr><th>scalar</th><th>config</th><th>test</th><th>statistic</th>"
        "<th>p-value</th><th>verdict</th><th>detail</th></tr>";
-  for (const Result* r : rs)
+  for (const TestResult* r : rs)
     p << "<tr id=\"" << result_anchor(*r) << "\"><td>" << html_escape(r->scalar) << "</td><td>"
       << html_escape(r->config) << "</td><td>" << html_escape(r->test) << "</td><td>"
-      << (r->statistic ? num(*r->statistic, 6) : "null") << "</td><td>" << (r->p_value ? num(*r->p_value, 4) : "-")
-      << "</td><td class=\"" << cell_class(*r) << "\">" << verdict(*r) << "</td><td>" << html_escape(r->detail)
+      << (std::isnan(r->statistic) ? "null" : num(r->statistic, 6)) << "</td><td>"
+      << (r->p_value ? num(*r->p_value, 4) : "-") << "</td><td class=\"" << cell_class(*r) << "\">" << verdict(*r)
+      << "</td><td>" << html_escape(r->detail)
       << (r->known_limitation.empty() ? "" : "<br><i>known limitation: " + html_escape(r->known_limitation) + "</i>")
       << (r->map_rows ? " <a href=\"#maps-" + result_anchor(*r) + "\">maps</a>" : "") << "</td></tr>";
   p << "</table>\n";
   return p.str();
 }
 
-void write_kernel_page(const std::string& k, const std::vector<const Result*>& rs, const BatteryRun& run,
+void write_kernel_page(const std::string& k, const std::vector<const TestResult*>& rs, const BatteryRun& run,
                        const ReportOptions& opt, const SampleSources& src, ReportSummary& sum) {
   const fs::path out(opt.out_dir);
   std::ostringstream p;
   p << page_start("warpcheck: " + k) << "<p><a href=\"index.html\">&larr; all kernels</a></p><h1>" << html_escape(k)
     << "</h1>\n";
   std::size_t kf = 0;
-  for (const Result* r : rs) kf += r->failed();
+  for (const TestResult* r : rs) kf += r->failed();
   p << "<div class=\"banner " << (kf ? "bad" : "good") << "\">"
     << (kf ? std::to_string(kf) + " test(s) FAILED" : "all tests passed (or are documented known limitations)")
     << "</div>\n"
     << results_table(rs) << "<h2>chi2 maps</h2>\n";
   // Failing maps first: that is where a reader looks.
-  std::vector<const Result*> maps;
-  for (const Result* r : rs)
+  std::vector<const TestResult*> maps;
+  for (const TestResult* r : rs)
     if (r->map_rows > 0) maps.push_back(r);
   std::stable_sort(maps.begin(), maps.end(),
-                   [](const Result* a, const Result* b) { return a->failed() > b->failed(); });
-  for (const Result* r : maps) p << chi2_maps(*r, run.samples, out, sum);
+                   [](const TestResult* a, const TestResult* b) { return a->failed() > b->failed(); });
+  for (const TestResult* r : maps) p << chi2_maps(*r, run.samples, out, sum);
   if (maps.empty())
     p << "<p class=\"muted\">No chi2 maps in these results (results written before maps were recorded, or a "
          "no-sample geometry).</p>";
   std::set<std::string> configs;
-  for (const Result* r : rs) configs.insert(r->config);
+  for (const TestResult* r : rs) configs.insert(r->config);
   p << "<h2>Sample sets</h2>\n" << sample_sets(k, src.cases, configs, opt, src.blue) << page_end();
   write_text(out / kernel_page(k), p.str());
   sum.files.push_back(kernel_page(k));
@@ -868,14 +869,14 @@ void write_kernel_page(const std::string& k, const std::vector<const Result*>& r
 std::string run_summary(const BatteryRun& run, const ReportOptions& opt, const ReportSummary& sum) {
   std::ostringstream x;
   x << "<p>Results: <code>" << html_escape(opt.results_path) << "</code>; significance alpha = " << num(run.alpha)
-    << " family-wise, " << html_escape(run.correction) << " correction across " << run.statistical_tests
+    << " family-wise, " << to_string(run.correction) << " correction across " << run.statistical_tests()
     << " statistical tests" << (run.samples ? "; " + std::to_string(*run.samples) + " samples per case" : "")
     << (run.seed ? "; seed " + std::to_string(*run.seed) : "") << ".</p>\n";
   if (run.complete && !*run.complete)
     x << "<div class=\"banner warn\">This run is INCOMPLETE (\"complete\": false): the battery was interrupted; "
          "cases it did not reach are missing.</div>\n";
-  std::vector<const Result*> failing;
-  for (const Result& r : run.results)
+  std::vector<const TestResult*> failing;
+  for (const TestResult& r : run.results)
     if (r.failed()) failing.push_back(&r);
   if (failing.empty())
     return x.str() + "<div class=\"banner good\">All " + std::to_string(run.results.size()) + " tests passed" +
@@ -885,11 +886,11 @@ std::string run_summary(const BatteryRun& run, const ReportOptions& opt, const R
            ".</div>\n";
   x << "<div class=\"banner bad\" id=\"failing\">" << failing.size() << " of " << run.results.size()
     << " tests FAILED</div>\n<ul class=\"failing\">";
-  for (const Result* r : failing)
+  for (const TestResult* r : failing)
     x << "<li><a href=\"" << kernel_page(r->kernel) << "#" << result_anchor(*r) << "\">" << html_escape(r->kernel)
       << " / " << html_escape(r->scalar) << " / " << html_escape(r->config) << ": " << html_escape(r->test) << "</a> "
       << (r->p_value ? "p = " + num(*r->p_value)
-                     : "statistic " + (r->statistic ? num(*r->statistic) : std::string("null")))
+                     : "statistic " + (std::isnan(r->statistic) ? std::string("null") : num(r->statistic)))
       << " <span class=\"muted\">" << html_escape(r->detail) << "</span>"
       << (r->map_rows ? " <a href=\"" + kernel_page(r->kernel) + "#maps-" + result_anchor(*r) + "\">(residual map)</a>"
                       : "")
@@ -910,17 +911,17 @@ std::string matrix(const Grouped& g) {
   for (const auto& t : g.tests) x << "<th>" << html_escape(t) << "</th>";
   x << "</tr>\n";
   for (const std::string& k : g.kernels) {
-    const std::vector<const Result*>& rs = g.by_kernel.at(k);
+    const std::vector<const TestResult*>& rs = g.by_kernel.at(k);
     std::vector<std::pair<std::string, std::string>> rows;  // (scalar, config), order of appearance
-    for (const Result* r : rs)
+    for (const TestResult* r : rs)
       if (std::find(rows.begin(), rows.end(), std::make_pair(r->scalar, r->config)) == rows.end())
         rows.emplace_back(r->scalar, r->config);
     for (const auto& [sc, cf] : rows) {
       x << "<tr><td><a href=\"" << kernel_page(k) << "\">" << html_escape(k) << "</a></td><td>" << html_escape(sc)
         << "</td><td>" << html_escape(cf) << "</td>";
       for (const auto& t : g.tests) {
-        const Result* hit = nullptr;
-        for (const Result* r : rs)
+        const TestResult* hit = nullptr;
+        for (const TestResult* r : rs)
           if (r->scalar == sc && r->config == cf && r->test == t) hit = r;
         if (!hit) {
           x << "<td class=\"absent\">&middot;</td>";

@@ -1,13 +1,12 @@
 // warpcheck list / warpcheck validate.
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
+#include <limits>
 #include <sstream>
-
-#include <boost/json.hpp>
-#include <set>
 
 #include "commands.h"
 #include "warpcheck/validation/battery.h"
@@ -141,60 +140,19 @@ int list_main(const std::vector<std::string>& a) {
   return 0;
 }
 
-std::string case_key(const std::string& kernel, const std::string& scalar, const std::string& config) {
-  return kernel + '\x1f' + scalar + '\x1f' + config;
-}
+namespace {
 
-// Results of an earlier run (the --json file of a killed or finished run) to continue from. The file must come
-// from the same --samples and --seed: mixing sample counts would make the run's verdicts meaningless.
-std::vector<TestResult> load_results_to_resume(const std::string& path, std::uint64_t samples, std::uint64_t seed,
-                                               std::set<std::string>& done) {
-  std::ifstream in(path);
-  if (!in) return {};  // nothing to resume: start afresh
-  std::stringstream text;
-  text << in.rdbuf();
-  if (text.str().empty()) return {};
-  boost::system::error_code ec;
-  const boost::json::value v = boost::json::parse(text.str(), ec);
-  if (ec || !v.is_object() || !v.as_object().contains("results"))
-    throw UsageError("cannot resume: '" + path + "' is not a warpcheck validate --json file");
-  const auto& o = v.as_object();
-  auto u64 = [&](const char* k) { return o.contains(k) ? boost::json::value_to<std::uint64_t>(o.at(k)) : 0; };
-  if (u64("samples") != samples || u64("seed") != seed)
-    throw UsageError("cannot resume: '" + path + "' was written with --samples " + std::to_string(u64("samples")) +
-                     " --seed " + std::to_string(u64("seed")) + "; give the same values");
-  std::vector<TestResult> out;
-  for (const auto& e : o.at("results").as_array()) {
-    const auto& r = e.as_object();
-    TestResult t;
-    auto str = [&](const char* k) { return r.contains(k) ? std::string(r.at(k).as_string()) : std::string(); };
-    t.kernel = str("kernel"), t.scalar = str("scalar"), t.config = str("config"), t.test = str("test");
-    t.detail = str("detail"), t.known_limitation = str("known_limitation");
-    t.statistic = r.at("statistic").is_null() ? std::numeric_limits<double>::quiet_NaN()
-                                              : boost::json::value_to<double>(r.at("statistic"));
-    if (!r.at("p_value").is_null())
-      t.p_value = boost::json::value_to<double>(r.at("p_value"));
-    else
-      t.passed = r.at("passed").as_bool();  // deterministic verdicts are kept; statistical ones re-judged
-    if (r.contains("map")) {
-      const auto& m = r.at("map").as_object();
-      t.map_rows = int(m.at("rows").to_number<double>()), t.map_cols = int(m.at("cols").to_number<double>());
-      for (const auto& x : m.at("observed").as_array()) t.observed.push_back(x.to_number<double>());
-      for (const auto& x : m.at("expected").as_array()) t.expected.push_back(x.to_number<double>());
-    }
-    done.insert(case_key(t.kernel, t.scalar, t.config));
-    out.push_back(std::move(t));
-  }
-  return out;
-}
-
-int validate_main(const std::vector<std::string>& a) {
+struct ValidateArgs {
   Selection sel;
   BatteryOptions opt;
   double alpha = 0.01;
   Correction corr = Correction::kHolm;
   std::string json;
   bool quiet = false, negative = false, resume = false;
+};
+
+// Parses validate's arguments into v; false when --help was printed instead.
+bool parse_validate_args(const std::vector<std::string>& a, ValidateArgs& v) {
   for (std::size_t i = 0; i < a.size(); ++i) {
     const std::string& f = a[i];
     auto value = [&]() -> const std::string& {
@@ -203,108 +161,147 @@ int validate_main(const std::vector<std::string>& a) {
     };
     if (f == "--help" || f == "-h") {
       std::fputs(kValidateHelp, stdout);
-      return 0;
-    } else if (take_selection(a, i, sel)) {
+      return false;
+    } else if (take_selection(a, i, v.sel)) {
     } else if (f == "--samples") {
-      opt.samples = parse_u64(f, value(), 1000, 1ULL << 34);
+      v.opt.samples = parse_u64(f, value(), 1000, 1ULL << 34);
     } else if (f == "--seed") {
-      opt.seed = parse_u64(f, value(), 0, ~0ULL);
+      v.opt.seed = parse_u64(f, value(), 0, ~0ULL);
     } else if (f == "--alpha") {
-      alpha = parse_double(f, value(), 1e-12, 0.5);
+      v.alpha = parse_double(f, value(), 1e-12, 0.5);
     } else if (f == "--correction") {
-      const std::string& v = value();
-      if (v == "holm")
-        corr = Correction::kHolm;
-      else if (v == "sidak")
-        corr = Correction::kSidak;
-      else
-        throw UsageError("--correction must be holm or sidak, got '" + v + "'");
+      const std::string& c = value();
+      if (c != "holm" && c != "sidak") throw UsageError("--correction must be holm or sidak, got '" + c + "'");
+      v.corr = c == "holm" ? Correction::kHolm : Correction::kSidak;
     } else if (f == "--threads") {
-      opt.threads = int(parse_u64(f, value(), 1, 1024));
+      v.opt.threads = int(parse_u64(f, value(), 1, 1024));
     } else if (f == "--json") {
-      json = value();
-      if (json.empty()) throw UsageError("--json needs a file name");
+      v.json = value();
+      if (v.json.empty()) throw UsageError("--json needs a file name");
     } else if (f == "--quiet") {
-      quiet = true;
+      v.quiet = true;
     } else if (f == "--negative-controls") {
-      negative = true;
+      v.negative = true;
     } else if (f == "--resume") {
-      resume = true;
+      v.resume = true;
     } else {
       throw UsageError("unknown option '" + f + "'");
     }
   }
-  if (resume && json.empty()) throw UsageError("--resume needs --json FILE (the file of the run to resume)");
-  const Registry reg = negative ? negative_control_registry() : default_registry();
-  std::vector<const Case*> cases = select_cases(reg, sel);
-  std::vector<TestResult> all;
-  if (resume) {
-    std::set<std::string> done;
-    all = load_results_to_resume(json, opt.samples, opt.seed, done);
-    // Known limitations are the current registry's policy, not the interrupted run's: re-tag resumed results.
-    for (TestResult& r : all)
-      for (const Case* c : select_cases(reg, sel))
-        if (c->kernel == r.kernel && c->scalar == r.scalar && c->config == r.config)
-          r.known_limitation = c->known_limitation;
-    const std::size_t before = cases.size();
-    std::erase_if(cases, [&](const Case* c) { return done.count(case_key(c->kernel, c->scalar, c->config)) > 0; });
-    std::fprintf(stderr, "resuming %s: %zu cases done, %zu to run\n", json.c_str(), before - cases.size(),
-                 cases.size());
+  if (v.resume && v.json.empty()) throw UsageError("--resume needs --json FILE (the file of the run to resume)");
+  return true;
+}
+
+bool same_case(const TestResult& r, const Case& c) {
+  return r.kernel == c.kernel && r.scalar == c.scalar && r.config == c.config;
+}
+
+// The results of an earlier run (the --json file of a killed or finished run) to continue from; removes their
+// cases from `cases`. The file must come from the same --samples and --seed: mixing sample counts would make
+// the run's verdicts meaningless. Known limitations are the current registry's policy, not the earlier run's:
+// the results of selected cases are re-tagged.
+std::vector<TestResult> results_to_resume(const ValidateArgs& v, std::vector<const Case*>& cases) {
+  std::ifstream in(v.json);
+  std::stringstream text;
+  if (in) text << in.rdbuf();
+  if (text.str().empty()) return {};  // nothing to resume: start afresh
+  BatteryRun earlier;
+  try {
+    earlier = parse_battery_json(text.str());
+  } catch (const std::runtime_error& e) {
+    throw UsageError("cannot resume: '" + v.json + "' is not a warpcheck validate --json file (" + e.what() + ")");
   }
-  if (!json.empty()) {  // fail on an unwritable path now, not after an hour of work
-    std::ofstream probe(json, std::ios::app);
-    if (!probe) throw UsageError("cannot write --json file '" + json + "'");
+  if (earlier.samples.value_or(0) != v.opt.samples || earlier.seed.value_or(0) != v.opt.seed)
+    throw UsageError("cannot resume: '" + v.json + "' was written with --samples " +
+                     std::to_string(earlier.samples.value_or(0)) + " --seed " +
+                     std::to_string(earlier.seed.value_or(0)) + "; give the same values");
+  for (TestResult& r : earlier.results)
+    for (const Case* c : cases)
+      if (same_case(r, *c)) r.known_limitation = c->known_limitation;
+  const std::size_t before = cases.size();
+  std::erase_if(cases, [&](const Case* c) {
+    return std::any_of(earlier.results.begin(), earlier.results.end(),
+                       [&](const TestResult& r) { return same_case(r, *c); });
+  });
+  std::fprintf(stderr, "resuming %s: %zu cases done, %zu to run\n", v.json.c_str(), before - cases.size(),
+               cases.size());
+  return std::move(earlier.results);
+}
+
+// The battery and the case's extras on one case, tagged with its known limitation; a battery that throws gives
+// one result "battery" with the error and no statistic.
+std::vector<TestResult> run_case(const Case& c, const BatteryOptions& opt) {
+  std::vector<TestResult> r;
+  try {
+    r = run_battery(c.make(), opt);
+    if (c.extras) {
+      auto extra = c.extras(opt);
+      r.insert(r.end(), extra.begin(), extra.end());
+    }
+  } catch (const std::exception& e) {
+    TestResult err;
+    err.kernel = c.kernel, err.scalar = c.scalar, err.config = c.config, err.test = "battery";
+    err.statistic = std::numeric_limits<double>::quiet_NaN();
+    err.detail = std::string("error: ") + e.what();
+    r.push_back(err);
+  }
+  for (auto& x : r) x.known_limitation = c.known_limitation;
+  return r;
+}
+
+void print_summary(const BatteryRun& run, std::size_t cases, double secs) {
+  std::fputs(format_table(run.results).c_str(), stdout);
+  std::size_t failed = 0, known = 0;
+  for (const auto& r : run.results) {
+    failed += r.failed();
+    known += !r.passed && !r.known_limitation.empty();
+  }
+  std::printf("\n%zu tests on %zu cases in %.1f s; alpha %g, %s correction over %zu statistical tests; %zu failed%s\n",
+              run.results.size(), cases, secs, run.alpha, to_string(run.correction), run.statistical_tests(), failed,
+              known ? (", " + std::to_string(known) + " known-limitation failures").c_str() : "");
+}
+
+}  // namespace
+
+int validate_main(const std::vector<std::string>& a) {
+  ValidateArgs v;
+  if (!parse_validate_args(a, v)) return 0;
+  const Registry reg = v.negative ? negative_control_registry() : default_registry();
+  std::vector<const Case*> cases = select_cases(reg, v.sel);
+  BatteryRun run;
+  run.alpha = v.alpha, run.correction = v.corr, run.samples = v.opt.samples, run.seed = v.opt.seed;
+  if (v.resume) run.results = results_to_resume(v, cases);
+  if (!v.json.empty()) {  // fail on an unwritable path now, not after an hour of work
+    std::ofstream probe(v.json, std::ios::app);
+    if (!probe) throw UsageError("cannot write --json file '" + v.json + "'");
   }
   const bool tty = ::isatty(2);
-  std::ostringstream meta;
-  meta << "\"samples\":" << opt.samples << ",\"seed\":" << opt.seed;
   const auto start = std::chrono::steady_clock::now();
   for (std::size_t k = 0; k < cases.size(); ++k) {
     const Case& c = *cases[k];
     const std::string label = "[" + std::to_string(k + 1) + "/" + std::to_string(cases.size()) + "] " + c.kernel +
                               " / " + c.scalar + " / " + c.config;
-    if (!quiet) {
-      opt.progress = [&](const std::string& phase, double frac) {
+    if (!v.quiet) {
+      v.opt.progress = [&](const std::string& phase, double frac) {
         if (tty) std::fprintf(stderr, "\r%s: %s %3.0f%%   ", label.c_str(), phase.c_str(), 100 * frac);
       };
       std::fprintf(stderr, tty ? "\r%s   " : "%s\n", label.c_str());
     }
-    std::vector<TestResult> r;
-    try {
-      r = run_battery(c.make(), opt);
-      if (c.extras) {
-        auto extra = c.extras(opt);
-        r.insert(r.end(), extra.begin(), extra.end());
-      }
-    } catch (const std::exception& e) {
-      TestResult err;
-      err.kernel = c.kernel, err.scalar = c.scalar, err.config = c.config, err.test = "battery";
-      err.statistic = std::numeric_limits<double>::quiet_NaN();
-      err.detail = std::string("error: ") + e.what();
-      r.push_back(err);
-    }
-    for (auto& x : r) x.known_limitation = c.known_limitation;
-    all.insert(all.end(), r.begin(), r.end());
-    if (!json.empty()) {
-      std::vector<TestResult> partial = all;
-      apply_correction(partial, alpha, corr);
-      write_file_atomically(json, to_json(partial, alpha, corr, meta.str() + ",\"complete\":false"));
+    const std::vector<TestResult> r = run_case(c, v.opt);
+    run.results.insert(run.results.end(), r.begin(), r.end());
+    if (!v.json.empty()) {  // so far, judged together, and marked incomplete: a killed run keeps what it finished
+      BatteryRun partial = run;
+      apply_correction(partial.results, run.alpha, run.correction);
+      partial.complete = false;
+      write_file_atomically(v.json, to_json(partial));
     }
   }
-  if (!quiet && tty) std::fprintf(stderr, "\n");
-  const std::size_t m = apply_correction(all, alpha, corr);
-  const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  std::fputs(format_table(all).c_str(), stdout);
-  std::size_t failed = 0, known = 0;
-  for (const auto& r : all) {
-    if (!r.passed && r.known_limitation.empty()) ++failed;
-    if (!r.passed && !r.known_limitation.empty()) ++known;
-  }
-  std::printf("\n%zu tests on %zu cases in %.1f s; alpha %g, %s correction over %zu statistical tests; %zu failed%s\n",
-              all.size(), cases.size(), secs, alpha, to_string(corr), m, failed,
-              known ? (", " + std::to_string(known) + " known-limitation failures").c_str() : "");
-  if (!json.empty()) write_file_atomically(json, to_json(all, alpha, corr, meta.str() + ",\"complete\":true"));
-  return all_passed(all) ? 0 : 1;
+  if (!v.quiet && tty) std::fprintf(stderr, "\n");
+  apply_correction(run.results, run.alpha, run.correction);
+  run.complete = true;
+  print_summary(run, cases.size(), std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  if (!v.json.empty()) write_file_atomically(v.json, to_json(run));
+  return all_passed(run.results) ? 0 : 1;
 }
 
 }  // namespace warpcheck::cli

@@ -299,19 +299,5 @@ TEST(Battery, RejectsMalformedSamplersWithAClearError) {
   EXPECT_THROW(run_battery(uniform_cone(), o), std::invalid_argument);
 }
 
-TEST(Json, HoldsAlphaCorrectionAndNullPValuesForDeterministicTests) {
-  TestResult det;
-  det.kernel = "k", det.scalar = "double", det.config = "c", det.test = "pdf-integral", det.statistic = 1e-17;
-  det.passed = true;
-  std::vector<TestResult> r = {stat(0.5), det};
-  r[0].test = "chi2";
-  apply_correction(r, 0.01, Correction::kHolm);
-  const std::string j = to_json(r, 0.01, Correction::kHolm);
-  EXPECT_NE(j.find("\"alpha\":0.01"), std::string::npos) << j;
-  EXPECT_NE(j.find("\"correction\":\"holm\""), std::string::npos);
-  EXPECT_NE(j.find("\"p_value\":null"), std::string::npos);
-  EXPECT_NE(j.find("\"p_value\":0.5"), std::string::npos);
-}
-
 }  // namespace
 }  // namespace warpcheck::validation

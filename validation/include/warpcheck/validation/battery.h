@@ -14,35 +14,19 @@
 //                 of the (reference) warp by 4th-order central differences in long double (deterministic)
 //   normalization:<what>  relative error of each declared Normalization (deterministic)
 // Statistical tests (those with a p-value) are judged together by apply_correction: one significance level
-// alpha for the whole run, Sidak or Holm corrected across all its statistical tests.
+// alpha for the whole run, Sidak or Holm corrected across all its statistical tests. The results and their
+// JSON file: results.h.
 #pragma once
 
 #include <cstdint>
 #include <functional>
-#include <optional>
 #include <string>
 #include <vector>
 
+#include "warpcheck/validation/results.h"
 #include "warpcheck/validation/sampler.h"
 
 namespace warpcheck::validation {
-
-enum class Correction { kSidak, kHolm };
-const char* to_string(Correction c);
-
-struct TestResult {
-  std::string kernel, scalar, config, test;
-  double statistic = 0;           // chi2 / KS D / relative error
-  std::optional<double> p_value;  // null for deterministic tests
-  bool passed = false;            // for statistical tests: set by apply_correction
-  std::string detail;             // human-readable: dof, pooled bins, tolerance, worst point, ...
-  std::string known_limitation;   // non-empty: a documented expected failure; it does not fail a run
-  // chi2 only: the grid over the bounding cap, row-major [radial][azimuth] (radial row r covers
-  // t = (1 - cos theta)/(1 - cos theta_max) in [r/R, (r+1)/R), column a covers phi in [2 pi a/A, 2 pi (a+1)/A)),
-  // observed counts and expected counts (n * bin mass) before pooling; empty for other tests.
-  int map_rows = 0, map_cols = 0;
-  std::vector<double> observed, expected;
-};
 
 struct BatteryOptions {
   std::uint64_t samples = 10'000'000;  // per sampler; see README "Choosing the sample count"
@@ -75,10 +59,6 @@ std::size_t apply_correction(std::vector<TestResult>& results, double alpha, Cor
 bool all_passed(const std::vector<TestResult>& results);
 // A fixed-width table: kernel, scalar, config, test, statistic, p-value, verdict.
 std::string format_table(const std::vector<TestResult>& results);
-// {"alpha":..., "correction":..., "statistical_tests": m, <extra_members>, "results":[...]}; extra_members is
-// raw JSON ("\"seed\":1,\"samples\":10") inserted as is.
-std::string to_json(const std::vector<TestResult>& results, double alpha, Correction c,
-                    const std::string& extra_members = "");
 
 // Convenience for a user's own GoogleTest: run the battery on one sampler and judge it at alpha.
 std::vector<TestResult> validate(const SamplerUnderTest& s, const BatteryOptions& options = {}, double alpha = 0.01,
@@ -105,8 +85,7 @@ QuadratureResult integrate_adaptive(const std::function<Real(Real)>& f, Real a, 
 // sliver of a corner inside a full ring) need one per chi-square column or the first rule misses the support.
 // radial_panels: initial panels of each inner (radial) line integral, the same for regions spanning many rings:
 // a narrow lobe on a line (a near-singular LTC's, 1e-4 rad wide) can fall between the nodes of a line's first
-// two 15-point rules, which then agree on the tails and stop (measured: the KS azimuth marginal of polygon-ltc
-// near-singular lost 0.23% of the mass with 1 panel, none with one per chi-square ring).
+// two 15-point rules, which then agree on the tails and stop.
 // abs_tol: an absolute accuracy of the region's integral that is enough (0: none, relative tol alone). Lines
 // that barely touch the support have tiny values, and a relative tolerance there asks for ever more bisections of
 // a jump that the pdf's own rounding blurs (a float pdf): see ks_cdfs.

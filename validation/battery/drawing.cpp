@@ -1,0 +1,97 @@
+// The battery's random streams, threads and draws (drawing.h).
+#include "battery/drawing.h"
+
+#include <cfloat>
+#include <cmath>
+#include <mutex>
+
+namespace warpcheck::validation::battery {
+namespace {
+
+std::uint64_t splitmix64(std::uint64_t& x) {
+  std::uint64_t z = (x += 0x9e3779b97f4a7c15ULL);
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
+}
+
+std::uint64_t fnv1a(const std::string& s, std::uint64_t h = 1469598103934665603ULL) {
+  for (unsigned char c : s) h = (h ^ c) * 1099511628211ULL;
+  return h;
+}
+
+}  // namespace
+
+std::mt19937_64 stream(std::uint64_t seed, const SamplerUnderTest& s, std::uint64_t purpose, std::uint64_t chunk) {
+  std::uint64_t x = seed ^ fnv1a(s.kernel + '\x1f' + s.scalar + '\x1f' + s.config);
+  x ^= splitmix64(x) + purpose * 0x632be59bd9b4e019ULL;
+  x ^= splitmix64(x) + chunk;
+  return std::mt19937_64(splitmix64(x));
+}
+
+Real scalar_epsilon(const std::string& scalar) {
+  if (scalar == "float") return FLT_EPSILON;
+  if (scalar == "long double") return LDBL_EPSILON;
+  return DBL_EPSILON;
+}
+
+int thread_count(const BatteryOptions& o) {
+  if (o.threads > 0) return o.threads;
+  return std::max(1u, std::thread::hardware_concurrency());
+}
+
+constexpr std::uint64_t kChunk = 1 << 16;
+
+Draws draw(const SamplerUnderTest& s, const BatteryOptions& o) {
+  const int R = o.radial_bins, A = o.azimuth_bins;
+  Draws d;
+  d.t.resize(o.samples);
+  d.phi.resize(o.samples);
+  d.counts.assign(std::size_t(R) * A, 0);
+  // A sample may land a rounding error beyond the cap's edge: t's error is about eps * sqrt(2 / omc) (the
+  // angle's error over the cap's angular radius). Within that slack it counts in the outermost ring.
+  const Real eps = scalar_epsilon(s.scalar);
+  const Real slack = 64 * eps * (1 + std::sqrt(2 / s.bounding_cap.one_minus_cos));
+  const std::size_t chunks = (o.samples + kChunk - 1) / kChunk;
+  std::mutex m;
+  std::atomic<std::size_t> done{0};
+  parallel_for(chunks, thread_count(o), [&](std::size_t c) {
+    std::mt19937_64 g = stream(o.seed, s, 1, c);
+    std::vector<std::uint64_t> local(d.counts.size(), 0);
+    std::uint64_t outside = 0, declined = 0, non_finite = 0;
+    const std::size_t end = std::min<std::size_t>(o.samples, (c + 1) * kChunk);
+    for (std::size_t i = c * kChunk; i < end; ++i) {
+      const double u0 = uniform01(g), u1 = uniform01(g);
+      const Sample x = s.sample(u0, u1);
+      constexpr double kInf = std::numeric_limits<double>::infinity();
+      if (!x.valid) {
+        ++declined, d.t[i] = kInf, d.phi[i] = kInf;
+        continue;
+      }
+      if (!all_finite(x.direction) || !std::isfinite(x.pdf)) {
+        ++non_finite, d.t[i] = kInf, d.phi[i] = kInf;
+        continue;
+      }
+      Real t, phi;
+      cap_coordinates(s.bounding_cap, x.direction.normalized(), t, phi);
+      if (!(t <= 1 + slack)) {
+        ++outside, d.t[i] = kInf, d.phi[i] = kInf;
+        continue;
+      }
+      t = std::min<Real>(t, 1);
+      d.t[i] = double(t);
+      d.phi[i] = double(phi / kTwoPi<Real>);
+      const int ri = std::min(R - 1, int(t * R));
+      const int ai = std::min(A - 1, int(phi / kTwoPi<Real> * A));
+      ++local[std::size_t(ri) * A + ai];
+    }
+    std::lock_guard lock(m);
+    for (std::size_t k = 0; k < local.size(); ++k) d.counts[k] += local[k];
+    d.outside += outside, d.declined += declined, d.non_finite += non_finite;
+    const std::size_t n = ++done;
+    if (o.progress && (n % 16 == 0 || n == chunks)) o.progress("sampling", double(n) / chunks);
+  });
+  return d;
+}
+
+}  // namespace warpcheck::validation::battery

@@ -1,0 +1,167 @@
+// The battery's statistical tests (tests.h): chi-square on an equal-area grid over the bounding cap with
+// expected counts by quadrature, and Kolmogorov-Smirnov on the two marginals in the cap's frame.
+#include <algorithm>
+#include <boost/math/distributions/chi_squared.hpp>
+#include <boost/math/distributions/kolmogorov_smirnov.hpp>
+#include <cmath>
+#include <numeric>
+#include <sstream>
+
+#include "battery/tests.h"
+
+namespace warpcheck::validation::battery {
+
+std::vector<Real> bin_masses(const SamplerUnderTest& s, const BatteryOptions& o) {
+  const int R = o.radial_bins, A = o.azimuth_bins;
+  std::vector<Real> mass(std::size_t(R) * A);
+  parallel_for(mass.size(), thread_count(o), [&](std::size_t k) {
+    const int ri = int(k / A), ai = int(k % A);
+    mass[k] = integrate_cap_region(s.pdf, s.bounding_cap, Real(ri) / R, Real(ri + 1) / R, kTwoPi<Real> * ai / A,
+                                   kTwoPi<Real> * (ai + 1) / A, o.quadrature_tolerance, 1, 1, s.boundary_planes);
+  });
+  return mass;
+}
+
+TestResult chi_square(const SamplerUnderTest& s, const BatteryOptions& o, const Draws& d,
+                      const std::vector<Real>& mass) {
+  TestResult r = make_result(s, "chi2");
+  const Real n = Real(o.samples);
+  // Mass the pdf puts outside the cap (or nowhere): the complement of what the bins hold. Declined and
+  // outside samples are compared against it.
+  const Real inside = std::accumulate(mass.begin(), mass.end(), Real(0));
+  const Real expected_elsewhere = std::max<Real>(0, n * (1 - inside));
+  const std::uint64_t observed_elsewhere = d.outside + d.declined + d.non_finite;
+  std::vector<std::pair<Real, Real>> bins;  // (expected, observed)
+  std::size_t impossible = 0;
+  for (std::size_t k = 0; k < mass.size(); ++k) {
+    const Real e = n * mass[k];
+    if (e <= 0 && d.counts[k] > 0) impossible += d.counts[k];
+    bins.emplace_back(e, Real(d.counts[k]));
+    r.observed.push_back(double(d.counts[k]));
+    r.expected.push_back(double(e));
+  }
+  r.map_rows = o.radial_bins, r.map_cols = o.azimuth_bins;
+  if (expected_elsewhere < 1e-3L && observed_elsewhere > 0)
+    impossible += observed_elsewhere;
+  else
+    bins.emplace_back(expected_elsewhere, Real(observed_elsewhere));
+  std::ostringstream detail;
+  if (impossible > 0) {
+    r.statistic = std::numeric_limits<double>::infinity();
+    r.p_value = 0.0;
+    detail << impossible << " samples where the pdf puts no mass (outside " << d.outside << ", declined " << d.declined
+           << ", non-finite " << d.non_finite << ")";
+    r.detail = detail.str();
+    return r;
+  }
+  // Pool every bin expected to hold fewer than min_expected samples into one; if the pool is still too
+  // small, fold it into the smallest regular bin.
+  std::sort(bins.begin(), bins.end());
+  Real pool_e = 0, pool_o = 0;
+  std::size_t pooled = 0;
+  std::vector<std::pair<Real, Real>> kept;
+  for (const auto& b : bins) {
+    if (b.first < o.min_expected)
+      pool_e += b.first, pool_o += b.second, ++pooled;
+    else
+      kept.push_back(b);
+  }
+  if (pool_e > 0 || pool_o > 0) {
+    if (pool_e >= o.min_expected || kept.empty())
+      kept.emplace_back(pool_e, pool_o);
+    else
+      kept.front().first += pool_e, kept.front().second += pool_o;
+  }
+  Real chi2 = 0;
+  for (const auto& [e, obs] : kept)
+    if (e > 0) chi2 += (obs - e) * (obs - e) / e;
+  const double dof = double(kept.size()) - 1;
+  r.statistic = double(chi2);
+  if (dof < 1) {
+    r.p_value = 1.0;
+    detail << "fewer than two bins after pooling";
+  } else {
+    boost::math::chi_squared dist(dof);
+    r.p_value = double(boost::math::cdf(boost::math::complement(dist, double(chi2))));
+    detail << "dof " << dof << ", " << mass.size() << " bins (" << o.radial_bins << "x" << o.azimuth_bins << "), "
+           << pooled << " pooled";
+  }
+  r.detail = detail.str();
+  return r;
+}
+
+namespace {
+
+// Kolmogorov-Smirnov against a CDF known at nodes x[0..M] (increasing). D is taken at the nodes only, where
+// the CDF is known to quadrature accuracy, instead of interpolating between them (linear interpolation of a
+// CDF with a kink, a polygon's vertex, errs by ~h * jump / 4, which at 1e7 samples is as large as the effect
+// being tested). D_nodes <= D, so the p-value from the continuous KS distribution is conservative: the
+// false-positive rate stays at most alpha, and with ~1000 nodes the loss of power is below what the sample
+// count resolves (the calibration test checks the p-values for uniformity).
+TestResult kolmogorov_smirnov(const SamplerUnderTest& s, std::string name, std::vector<double> values,
+                              const std::vector<Real>& x, const std::vector<Real>& F) {
+  TestResult r = make_result(s, std::move(name));
+  std::sort(values.begin(), values.end());
+  const double n = double(values.size());
+  double D = 0;
+  std::size_t i = 0;  // number of values <= x[k]
+  for (std::size_t k = 0; k < x.size(); ++k) {
+    const double xk = k + 1 == x.size() ? std::numeric_limits<double>::max() : double(x[k]);
+    while (i < values.size() && values[i] <= xk) ++i;
+    // At the last node the empirical CDF counts every finite sample; samples beyond (outside the cap,
+    // declined) leave it below 1.
+    D = std::max(D, std::abs(double(F[k]) - double(i) / n));
+  }
+  r.statistic = D;
+  boost::math::kolmogorov_smirnov_distribution<double> dist(n);
+  r.p_value = boost::math::cdf(boost::math::complement(dist, D));
+  std::ostringstream detail;
+  detail << "n " << values.size() << ", D at " << x.size() << " nodes of the CDF from quadrature, mass "
+         << double(F.back());
+  r.detail = detail.str();
+  return r;
+}
+
+}  // namespace
+
+KsCdfs ks_cdfs(const SamplerUnderTest& s, const BatteryOptions& o) {
+  const int M = o.ks_cdf_nodes;
+  const Cap<Real>& cap = s.bounding_cap;
+  // Radial marginal: nodes clustered at both ends (Chebyshev-Lobatto), where the densities of visible-area
+  // and horizon-cut samplers are singular or steep, so that linear interpolation stays far below 1/sqrt(n).
+  std::vector<Real> xr(M + 1), xa(M + 1), dr(M, 0), da(M, 0);
+  for (int k = 0; k <= M; ++k) {
+    xr[k] = (1 - std::cos(kPi<Real> * k / M)) / 2;
+    xa[k] = Real(k) / M;
+  }
+  xr[0] = 0, xr[M] = 1;
+  // The CDFs need far less than the bins: KS at 1e7 samples resolves D ~ 1.36 / sqrt(n) = 4e-4, and slab errors
+  // of 1e-6 relative sum to at most 1e-6 in F. Each of the 1024 azimuth slabs spans the whole cap, silhouette
+  // included, so this is where a tight tolerance costs most. Each slab's radial lines start with one panel per
+  // chi-square ring (as the radial slabs start with one azimuth panel per column), so that a lobe narrower than
+  // the first rule's node spacing (a near-singular LTC's) cannot fall between the nodes.
+  const Real ks_tol = std::max<Real>(o.quadrature_tolerance, 1e-6L);
+  // And an absolute accuracy per slab of 1e-3 of D's resolution 1.36 / sqrt(n) shared by the M slabs (4.2e-10 at
+  // 1e7 samples): the slabs' errors then move F by at most 1e-3 of what KS can resolve, and the lines that barely
+  // touch a float pdf's support (whose jumps its rounding blurs) stop there instead of at their panel budget.
+  const Real ks_abs = Real(1e-3) * Real(1.36) / std::sqrt(Real(o.samples)) / Real(M);
+  parallel_for(std::size_t(2 * M), thread_count(o), [&](std::size_t k) {
+    if (k < std::size_t(M))
+      dr[k] = integrate_cap_region(s.pdf, cap, xr[k], xr[k + 1], 0, kTwoPi<Real>, ks_tol, o.azimuth_bins, 1,
+                                   s.boundary_planes, ks_abs);
+    else
+      da[k - M] = integrate_cap_region(s.pdf, cap, 0, 1, kTwoPi<Real> * xa[k - M], kTwoPi<Real> * xa[k - M + 1], ks_tol,
+                                       1, o.radial_bins, s.boundary_planes, ks_abs);
+  });
+  std::vector<Real> Fr(M + 1, 0), Fa(M + 1, 0);
+  for (int k = 0; k < M; ++k) Fr[k + 1] = Fr[k] + dr[k], Fa[k + 1] = Fa[k] + da[k];
+  if (o.progress) o.progress("ks", 0.5);
+  return {std::move(xr), std::move(Fr), std::move(xa), std::move(Fa)};
+}
+
+void ks_tests(const SamplerUnderTest& s, const KsCdfs& c, Draws& d, std::vector<TestResult>& out) {
+  out.push_back(kolmogorov_smirnov(s, "ks-radial", std::move(d.t), c.xr, c.Fr));
+  out.push_back(kolmogorov_smirnov(s, "ks-azimuth", std::move(d.phi), c.xa, c.Fa));
+}
+
+}  // namespace warpcheck::validation::battery

@@ -1,0 +1,61 @@
+// warpcheck/validation/results.h: a battery run's results and their JSON file.
+//
+// One TestResult per (kernel, scalar, config, test); a BatteryRun holds a run's results with the significance
+// level and correction that judged them. `warpcheck validate --json` writes a BatteryRun with to_json,
+// `--resume` and `warpcheck report` read it back with parse_battery_json. The file:
+//
+//   {"alpha":0.01,"correction":"holm","statistical_tests":m,"samples":N,"seed":S,"complete":true,"results":[
+//   {"kernel":..,"scalar":..,"config":..,"test":..,"statistic":x,"p_value":p|null,"passed":b,"detail":..,
+//    "known_limitation":.. (only when set), "map":{"rows":R,"cols":A,"observed":[..],"expected":[..]} (chi2)},
+//   ...
+//   ]}
+//
+// one result per line. samples, seed and complete are present when set; statistical_tests is written for other
+// readers and recomputed from the results on reading. Numbers are written in the shortest form that reads back
+// to the same double and are read exactly, so a file round-trips bit for bit; a NaN statistic is null,
+// +-infinity is +-1e999 (JSON has no infinity; parsers read 1e999 as infinity).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace warpcheck::validation {
+
+enum class Correction { kSidak, kHolm };
+const char* to_string(Correction c);
+
+struct TestResult {
+  std::string kernel, scalar, config, test;
+  double statistic = 0;           // chi2 / KS D / relative error; NaN when there is none (the battery threw)
+  std::optional<double> p_value;  // null for deterministic tests
+  bool passed = false;            // for statistical tests: set by apply_correction
+  std::string detail;             // human-readable: dof, pooled bins, tolerance, worst point, ...
+  std::string known_limitation;   // non-empty: a documented expected failure; it does not fail a run
+  // chi2 only: the grid over the bounding cap, row-major [radial][azimuth] (radial row r covers
+  // t = (1 - cos theta)/(1 - cos theta_max) in [r/R, (r+1)/R), column a covers phi in [2 pi a/A, 2 pi (a+1)/A)),
+  // observed counts and expected counts (n * bin mass) before pooling; empty for other tests.
+  int map_rows = 0, map_cols = 0;
+  std::vector<double> observed, expected;
+
+  // Failed and not a documented limitation: this fails the run.
+  bool failed() const { return !passed && known_limitation.empty(); }
+};
+
+struct BatteryRun {
+  double alpha = 0.01;  // family-wise significance level of the run
+  Correction correction = Correction::kHolm;
+  std::optional<std::uint64_t> samples, seed;  // the CLI's --samples and --seed
+  std::optional<bool> complete;                // false while the CLI is still running (or was killed)
+  std::vector<TestResult> results;
+
+  // The number of results with a p-value: the m of the correction.
+  std::size_t statistical_tests() const;
+};
+
+std::string to_json(const BatteryRun& run);
+// Reads what to_json writes. Throws std::runtime_error naming the first missing or mistyped member.
+BatteryRun parse_battery_json(const std::string& text);
+
+}  // namespace warpcheck::validation

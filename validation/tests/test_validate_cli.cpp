@@ -1,0 +1,128 @@
+// Specification of `warpcheck validate --json FILE --resume` as a process: a run killed with SIGKILL keeps the
+// cases it finished in FILE, bit for bit, and the same command with --resume runs only the others; a file from
+// other --samples is refused.
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <optional>
+#include <thread>
+
+#include "warpcheck/validation/results.h"
+
+extern char** environ;
+
+using namespace warpcheck::validation;
+namespace fs = std::filesystem;
+
+namespace {
+
+// The CLI is built into the build root; the test executable runs from build/validation/ or the build root.
+fs::path warpcheck_cli() {
+  fs::path dir = fs::read_symlink("/proc/self/exe").parent_path();
+  if (!fs::exists(dir / "warpcheck")) dir = dir.parent_path();
+  return dir / "warpcheck";
+}
+
+// Starts the CLI with args, stdout and stderr to files in dir; returns its pid.
+pid_t start(const std::vector<std::string>& args, const fs::path& dir, const std::string& name) {
+  std::vector<std::string> all = {warpcheck_cli().string()};
+  all.insert(all.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (auto& a : all) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t files;
+  posix_spawn_file_actions_init(&files);
+  posix_spawn_file_actions_addopen(&files, 1, (dir / (name + ".out")).c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_addopen(&files, 2, (dir / (name + ".err")).c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  pid_t pid = -1;
+  const int rc = posix_spawn(&pid, argv[0], &files, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&files);
+  return rc == 0 ? pid : -1;
+}
+
+int exit_status(pid_t pid) {
+  int status = 0;
+  waitpid(pid, &status, 0);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+std::string read_all(const fs::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+}
+
+// The file of a running CLI, once it parses (the CLI replaces it atomically, so it always does once it exists).
+std::optional<BatteryRun> peek(const fs::path& p) {
+  const std::string text = read_all(p);
+  if (text.empty()) return std::nullopt;
+  return parse_battery_json(text);
+}
+
+}  // namespace
+
+TEST(ValidateCli, AKilledRunResumedWithTheSameCommandKeepsWhatItFinishedAndRunsOnlyTheRest) {
+  ASSERT_TRUE(fs::exists(warpcheck_cli())) << "build the warpcheck executable";
+  const fs::path dir = fs::temp_directory_path() / ("warpcheck-resume-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path json = dir / "results.json";
+  // Two cases, sphere-solid-angle double far and tiny, each a few seconds of quadrature.
+  const std::vector<std::string> command = {
+      "validate", "--kernel",   "sphere-solid-angle", "--scalar", "double",    "--config", "far",
+      "--config", "tiny",       "--samples",          "2000",     "--threads", "1",        "--quiet",
+      "--json",   json.string()};
+
+  // Kill the run as soon as its file holds the first case.
+  const pid_t pid = start(command, dir, "killed");
+  ASSERT_GT(pid, 0);
+  std::optional<BatteryRun> first;
+  for (auto t0 = std::chrono::steady_clock::now(); std::chrono::steady_clock::now() - t0 < std::chrono::minutes(5);) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    if ((first = peek(json)) && !first->results.empty()) break;
+  }
+  ::kill(pid, SIGKILL);
+  EXPECT_EQ(exit_status(pid), 128 + SIGKILL);
+  first = peek(json);
+  ASSERT_TRUE(first && !first->results.empty()) << read_all(dir / "killed.err");
+  ASSERT_EQ(first->complete, false) << "the run finished before it was killed";
+  for (const TestResult& r : first->results) ASSERT_EQ(r.config, "far");
+
+  std::vector<std::string> resume = command;
+  resume.push_back("--resume");
+  ASSERT_EQ(exit_status(start(resume, dir, "resumed")), 0) << read_all(dir / "resumed.err");
+  EXPECT_NE(read_all(dir / "resumed.err").find("1 cases done, 1 to run"), std::string::npos);
+  const BatteryRun done = parse_battery_json(read_all(json));
+  EXPECT_EQ(done.complete, true);
+  // The finished case's results as they were, then the other case's, each once.
+  ASSERT_GT(done.results.size(), first->results.size());
+  for (std::size_t i = 0; i < done.results.size(); ++i) {
+    const TestResult& r = done.results[i];
+    EXPECT_EQ(r.config, i < first->results.size() ? "far" : "tiny") << i;
+    if (i >= first->results.size()) continue;
+    const TestResult& a = first->results[i];
+    EXPECT_EQ(a.test, r.test);
+    EXPECT_EQ(a.statistic, r.statistic) << r.test;
+    EXPECT_EQ(a.p_value, r.p_value) << r.test;
+    EXPECT_EQ(a.detail, r.detail) << r.test;
+    EXPECT_EQ(a.expected, r.expected) << r.test;
+    EXPECT_EQ(a.observed, r.observed) << r.test;
+  }
+  EXPECT_EQ(done.results.size(), 2 * first->results.size());
+
+  // Other --samples: refused with the usage status, the file untouched.
+  const std::string before = read_all(json);
+  std::vector<std::string> other = resume;
+  other[std::find(other.begin(), other.end(), "2000") - other.begin()] = "3000";
+  EXPECT_EQ(exit_status(start(other, dir, "refused")), 2);
+  EXPECT_NE(read_all(dir / "refused.err").find("--samples 2000"), std::string::npos) << read_all(dir / "refused.err");
+  EXPECT_EQ(read_all(json), before);
+  fs::remove_all(dir);
+}
