@@ -578,7 +578,9 @@ TEST(PolygonSolidAngle, ALongStripWhoseVerticesAreNearlyAntipodalSeenFromX) {
         ASSERT_TRUE(s.valid());
         const L margin = cone_margin(g, s.direction, clipped);
         if (margin < -tol) ++outside;
-        if (margin > tol) EXPECT_GT(pdf_polygon_solid_angle(g, s.direction, clipped), T(0));
+        if (margin > tol) {
+          EXPECT_GT(pdf_polygon_solid_angle(g, s.direction, clipped), T(0));
+        }
       }
     EXPECT_EQ(outside, 0) << (clipped ? "clipped" : "plain");
   }
@@ -604,7 +606,9 @@ TEST(PolygonSolidAngle, ASliversTwoLongEdgesOnOneGreatCircleAreSplitAtTheSameMid
     for (int b = a + 1; b < fan.count; ++b)
       EXPECT_GT(fan.u[a].dot(fan.u[b]), -0.9) << "fan vertices " << a << " and " << b << " nearly antipodal";
   const auto v = make_polygon_solid_angle_view(g, false);
-  if (v.valid()) EXPECT_LE(v.solid_angle, 1e-15);
+  if (v.valid()) {
+    EXPECT_LE(v.solid_angle, 1e-15);
+  }
   // In long double the sliver has a solid angle, and its samples lie on the arc from V2 to V0.
   PolygonLightGeometry<L> gl;
   gl.light.count = 3;
