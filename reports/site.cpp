@@ -487,15 +487,21 @@ bool history_point(const json::value& v, double& x, double& y) {
   return hx && hy;
 }
 
-std::string worst_case_section(const fs::path& data) {
-  std::ostringstream o;
-  o << "<h2 id=\"worst\">Worst-case searches</h2>\n";
-  const fs::path dir = data / "worst-cases";
+// The .json files of a folder, sorted by name (none when the folder is missing).
+std::vector<fs::path> json_files(const fs::path& dir) {
   std::vector<fs::path> files;
   if (fs::exists(dir))
     for (const auto& e : fs::directory_iterator(dir))
       if (e.path().extension() == ".json") files.push_back(e.path());
   std::sort(files.begin(), files.end());
+  return files;
+}
+
+std::string worst_case_section(const fs::path& data) {
+  std::ostringstream o;
+  o << "<h2 id=\"worst\">Worst-case searches</h2>\n";
+  const fs::path dir = data / "worst-cases";
+  const std::vector<fs::path> files = json_files(dir);
   if (files.empty())
     return o.str() + not_run("no recorded worst case in data/worst-cases/",
                              "warpcheck worst-case --search NAME --seconds 600 --json data/worst-cases/NAME.json "
@@ -577,11 +583,7 @@ std::string bench_section(const fs::path& data) {
   std::ostringstream o;
   o << "<h2 id=\"bench\">Benchmarks</h2>\n";
   const fs::path dir = data / "bench";
-  std::vector<fs::path> files;
-  if (fs::exists(dir))
-    for (const auto& e : fs::directory_iterator(dir))
-      if (e.path().extension() == ".json") files.push_back(e.path());
-  std::sort(files.begin(), files.end());
+  const std::vector<fs::path> files = json_files(dir);
   if (files.empty())
     return o.str() + not_run("no Google Benchmark JSON in data/bench/",
                              "build/<benchmark> --benchmark_format=json --benchmark_out=data/bench/<name>.json");

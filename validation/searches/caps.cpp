@@ -12,17 +12,15 @@
 //                              boundary of the image cap g(C); the angle (rad) by which g(w) misses it.
 #include <cmath>
 
+#include "searches/objective.h"
 #include "warpcheck/projected_cap.h"
 #include "warpcheck/sptd.h"
 #include "warpcheck/validation/searches.h"
 
 namespace warpcheck::validation {
 
-using L = long double;
 namespace {
 
-constexpr L kNaN = std::numeric_limits<L>::quiet_NaN();
-constexpr L kInf = std::numeric_limits<L>::infinity();
 constexpr L kPiL = std::numbers::pi_v<L>;
 
 L angle_between(const Vec3<L>& a, const Vec3<L>& b) { return std::atan2(a.cross(b).norm(), a.dot(b)); }

@@ -25,17 +25,13 @@
 #include <cmath>
 #include <string_view>
 
+#include "searches/objective.h"
 #include "warpcheck/catalogue.h"
 #include "warpcheck/validation/searches.h"
 
 namespace warpcheck::validation {
 
-using L = long double;
 namespace {
-
-constexpr L kNaN = std::numeric_limits<L>::quiet_NaN();
-constexpr L kInf = std::numeric_limits<L>::infinity();
-constexpr L kDeg = std::numbers::pi_v<L> / 180;
 
 // ---- Geometry families: parameters -> long double geometry, and rounding to T ---------------------------
 

@@ -5,18 +5,14 @@
 #include <span>
 #include <string>
 
+#include "searches/objective.h"
 #include "warpcheck/polygon_error_analysis.h"
 #include "warpcheck/polygon_projected.h"
 #include "warpcheck/validation/searches.h"
 
 namespace warpcheck::validation {
 
-using L = long double;
 namespace {
-
-constexpr L kNaN = std::numeric_limits<L>::quiet_NaN();
-constexpr L kInf = std::numeric_limits<L>::infinity();
-constexpr L kDeg = std::numbers::pi_v<L> / 180;
 
 // ---- Peters 2021 Sec. 3.6: backward error of the decentral inversion -------------------------------------
 //
