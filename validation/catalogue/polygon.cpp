@@ -149,11 +149,12 @@ const char* polygon_known_limitation(const std::string& kernel, const std::strin
     return "float cannot resolve a 1 mm light 40 m away (Peters 2021 Fig. 7b): its unit vectors there are 6e-8 rad "
            "apart, 1/426 of the light's width, so samples lie on a lattice the bins resolve at 1e7 samples (chi2, KS) "
            "and some round to just outside the light (pdf 0: pdf-consistency 1); measured on Turk: 343292 distinct "
-           "directions and 541 outside in 1e6 samples; see registry_polygon.cpp";
+           "directions and 541 outside in 1e6 samples; see validation/catalogue/polygon.cpp";
   if (kernel == "polygon-projected-solid-angle-biased")
     return "biased by design (Peters 2021 Sec. 6.4: no iteration, arctangent approximated to 1.2e-5 rad); the "
            "battery is expected to see the bias at 1e7 samples (double: chi2 p = 0 straddling-horizon, "
-           "pdf-consistency 6.8e-2 decentral-square, normalisation 2.8e-6..1.3e-4); see registry_polygon.cpp";
+           "pdf-consistency 6.8e-2 decentral-square, normalisation 2.8e-6..1.3e-4); see "
+           "validation/catalogue/polygon.cpp";
   if (kernel == "baseline-arvo-triangle" && scalar != "long double" && (config == "far-1cm" || config == "far-1mm"))
     return "Arvo 1995 as published cancels on tiny distant triangles (Peters 2021 Sec. 5, Fig. 7): double "
            "pdf-consistency 6.7e-4 (1 cm at 40 m) and 1 (1 mm: samples outside the light); a baseline, not fixed";

@@ -216,7 +216,8 @@ template <template <class> class K, class T> Case make_case(const ProjectedCapCo
     s.normalizations.push_back(mean);
     if constexpr (std::is_same_v<T, float>) {
       s.tolerance = projected_cap_float_tolerance(c.name);
-      s.tolerance_note = "float: twice the measured float error of this configuration (registry_projected_cap.cpp)";
+      s.tolerance_note =
+          "float: twice the measured float error of this configuration (validation/catalogue/projected_cap.cpp)";
     }
     return s;
   };

@@ -63,7 +63,7 @@ const SphereConfig kConfigs[] = {
 constexpr const char* kVisibleAreaFloat =
     "float visible-area sampling: the density ~1/cos_light is wrong by O(1) within ~eps|f|^2 of the silhouette "
     "(disc = r^2 - |f_perp|^2 cancels), a band of mass ~sqrt(FLT_EPSILON) = 3.5e-4; measured pdf-integral 3.1e-4 "
-    "(near) to 5.7e-4 (far) at 1e7 samples; see registry_sphere.cpp";
+    "(near) to 5.7e-4 (far) at 1e7 samples; see validation/catalogue/sphere.cpp";
 
 // The normalisation check of each sphere kernel: what its normaliser measures, and the independent reference.
 struct SphereKernelCheck {

@@ -28,9 +28,9 @@ namespace {
 // And each edge's own half of its ellipse: an edge's points q in the upper hemisphere satisfy
 // n_xy . q_xy = -n_z q_z, so n_xy . w has one sign over every direction w that reaches the edge; the sector,
 // bounded by the rays through the polygon's vertices, lies within the edge's azimuth range, so n_l,xy . w must
-// not change sign across it (same test at s0 and s1). Without this constraint (before 2026-12-01) the search
-// found its worst cases (7.8e-2 after two iterations) in sectors containing the direction where the outer edge's
-// great circle meets the horizon, i.e. the tip of its ellipse: no polygon has such a sector.
+// not change sign across it (same test at s0 and s1). Without this constraint the search finds its worst cases
+// (7.8e-2 after two iterations) in sectors containing the direction where the outer edge's great circle meets the
+// horizon, i.e. the tip of its ellipse: no polygon has such a sector.
 std::vector<SearchParameter> sector_parameters() {
   constexpr L max_tilt = std::numbers::pi_v<L> / 2;
   return {{"inner_tilt", 0, max_tilt, "inner edge normal: angle from the zenith (rad)"},

@@ -4,7 +4,7 @@
 // Eigen needs NumTraits for a custom scalar (Eigen's "Using custom scalar types" page). Boost specialises
 // std::numeric_limits for fvar (as its root type's), which GenericNumTraits reads for epsilon, digits, etc.;
 // we add what GenericNumTraits cannot know: that fvar needs initialisation (a class type) and its operation
-// costs (a first-order fvar carries two numbers). The elementary functions (sqrt, abs, ...) are found by
+// costs (a first-order fvar carries two numbers). The elementary functions (sqrt, abs, ...) resolve by
 // argument-dependent lookup in Boost's namespace, which is how Eigen's numext calls them.
 #pragma once
 

@@ -69,8 +69,8 @@ TEST(Calibration, CorrectKernelsGiveUniformPValuesAndFailAtMostTwiceAlphaOfTheTi
   }
   EXPECT_EQ(p_by_test.size(), 3u);
   // (2) Failure rate at most 2 alpha: at most 2 of 100 runs. With an exact battery the number of failed runs
-  // is Binomial(100, <= 0.01), which exceeds 2 with probability at most 0.079: the criterion, stated
-  // with its own false-positive rate.
+  // is Binomial(100, <= 0.01), which exceeds 2 with probability at most 0.079: the criterion, stated with its
+  // own false-positive rate.
   RecordProperty("failed_runs", failed_runs);
   EXPECT_LE(failed_runs, int(2 * kAlpha * kSeeds));
 }

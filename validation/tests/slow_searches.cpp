@@ -1,4 +1,4 @@
-// Every worst-case search for 30 s (label "slow"): each must find a finite worst case (issue 6 acceptance).
+// Every worst-case search for 30 s (label "slow"): each must find a finite worst case.
 #include <gtest/gtest.h>
 
 #include <cmath>

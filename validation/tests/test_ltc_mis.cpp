@@ -63,9 +63,9 @@ TEST(Ltc, SingularOrReflectingTransformsGiveNoSample) {
   EXPECT_EQ(pdf_ltc_polygon(LtcPolygonGeometry<double>{pg, m}, Vec3<double>(0.5, 0, 1)), 0);
   // Singular up to rounding: determinant() is 1.4e-17 > 0, but the cofactor expansion that Eigen's inverse()
   // divides by is exactly 0 (its inverse() has -inf entries). No sample, and no division by zero: UBSan's
-  // float-divide-by-zero in the sanitizer build, the FE_DIVBYZERO flag in any build (raised here before
-  // make_ltc_polygon_view inverted with the determinant it tests; measured with g++ -O3, where the view of the
-  // identity raises none).
+  // float-divide-by-zero in the sanitizer build, the FE_DIVBYZERO flag in any build (make_ltc_polygon_view
+  // inverts with the determinant it tests; Eigen's inverse() raises the flag here with g++ -O3, the view of the
+  // identity none).
   Mat3<double> s;
   s << -0.97724830453404243, -0.71395549903980848, 0.31213760910876431, -0.011186738735074364, 0.45739249687330075,
       0.25797111957173724, 0.56127352143764009, -0.45829810002916671, -0.65376533080210242;
@@ -81,8 +81,7 @@ TEST(Ltc, SingularOrReflectingTransformsGiveNoSample) {
 
 // pdf() at the sampler's own direction gives the sampler's pdf, to the rounding of the density formula (16 eps, the
 // fuzz target's allowance), for a near-singular M (sigma_1 / sigma_3 = 1024): Eigen's inverse is off by |E| =
-// |M Minv - I| = 8.9e-14, and 1 / |Minv w|^3 made the density 3 (E w).w = -8.3e-14 off (fuzz_ltc_double b98e6f95,
-// issue 7).
+// |M Minv - I| = 8.9e-14, and 1 / |Minv w|^3 with that inverse makes the density 3 (E w).w = -8.3e-14 off.
 TEST(Ltc, PdfEqualsTheSamplePdfForANearSingularTransform) {
   LtcPolygonGeometry<double> g;
   g.polygon = PolygonLightGeometry<double>{
@@ -100,7 +99,7 @@ TEST(Ltc, PdfEqualsTheSamplePdfForANearSingularTransform) {
 
 // M^-1 is a two-sided inverse for an ill-conditioned M (cond 6e10): the 3x3 cofactor formula of Eigen's
 // inverse() and computeInverseAndDetWithCheck gives |M X - I| = 1.6e-58 but |X M - I| = 2.2 here, and the sample's
-// pdf (from M c) and pdf(direction) (from X w) were 0.83 % apart (fuzz_ltc_double f84856d2, issue 7). With LU
+// pdf (from M c) and pdf(direction) (from X w) then are 0.83 % apart. With LU
 // (ltc_inverse) both residuals are ~eps cond(M) or less, and the two densities agree to what the conditioning
 // leaves: w is rounded to eps, which X stretches by |M c| / sigma_3 = 8e7 into 3e-8 rad of c, moving |M c|^3 by up
 // to 3 sigma_1 3e-8 / |M c| = 7e-5 relative (measured: 3.2e-6).
@@ -131,10 +130,10 @@ TEST(Ltc, TheInverseIsTwoSidedAndPdfMatchesTheSamplePdfForATransformOfCondition6
 
 // Near both tips of a light straddling the horizon (the battery's polygon-ltc lobe-away), the float sampler's
 // density at its samples follows the long double warp's to 64 eps_f, for xi_0 within [1e-4, 1e-3] of either end.
-// There the area left to a tip on the horizon grows with the cube of the angle: the difference of Eq. 1's two
-// ellipse areas in float (2.9e-4 at xi_0 in [3e-4, 6e-4]) and the sector target xi_0 A_Sigma - sum A_k
-// (1.4e-4 at 1 - xi_0 in [3e-4, 6e-4]) had left it far off (issue 5; polygon_projected.h: EllipseAreaScalar
-// and the sector selection from the nearer end). Measured after both: 4.6e-6.
+// There the area left to a tip on the horizon grows with the cube of the angle, and two differences lose it to
+// cancellation: Eq. 1's two ellipse areas in float (density error 2.9e-4 at xi_0 in [3e-4, 6e-4]) and the sector
+// target xi_0 A_Sigma - sum A_k (1.4e-4 at 1 - xi_0 in [3e-4, 6e-4]). polygon_projected.h avoids both
+// (EllipseAreaScalar, and the sector selected from the nearer end), leaving 4.6e-6.
 TEST(Ltc, FloatSamplesNearTheTipsOfALightStraddlingTheHorizonFollowTheLongDoubleWarp) {
   PolygonLightGeometry<L> pg;
   pg.shading.position = Vec3<L>(0, 0, 0);
@@ -166,9 +165,8 @@ TEST(Ltc, FloatSamplesNearTheTipsOfALightStraddlingTheHorizonFollowTheLongDouble
 }
 
 // pdf() is positive at samples well inside the light when two vertices 3e51 apart (at 2e67) lie on the horizon
-// up to rounding: the edge planes of the transformed polygon M^-1 P came from rounded vertices, and that edge's
-// became the horizon with a random orientation, pdf 0 at samples 0.09 rad inside (fuzz_ltc_double 834135fe,
-// issue 7).
+// up to rounding. Edge planes of the transformed polygon M^-1 P taken from its rounded vertices turn that edge's
+// plane into the horizon with a random orientation, and pdf() is 0 at samples 0.09 rad inside.
 TEST(Ltc, PdfIsPositiveAtSamplesInsideALightWithAShortEdgeOnTheHorizon) {
   LtcPolygonGeometry<double> g;
   g.polygon = PolygonLightGeometry<double>{
@@ -195,8 +193,7 @@ TEST(Ltc, PdfIsPositiveAtSamplesInsideALightWithAShortEdgeOnTheHorizon) {
 // A light accepted as planar although its vertices leave the plane by far more than the offsets' rounding (here
 // 6.4e-8, the rounding of coordinates ~3.2e9), seen from 2.6e-7 off that plane and 24 away: the kernels see the
 // flattened light (make_polygon_view), whose projected solid angle Lambert's formula gives in long double. Unflattened,
-// the cone of the vertices seen from x was not convex and A_Sigma came out 1.4e-15 for 1.4e-11 (fuzz_ltc_double
-// 5692ae35, issue 7).
+// the cone of the vertices seen from x is not convex and A_Sigma comes out 1.4e-15 for 1.4e-11.
 TEST(Ltc, ANonPlanarLightSeenFromCloseToItsPlaneIsSampledAsItsFlattening) {
   LtcPolygonGeometry<double> g;
   g.polygon =
@@ -246,7 +243,7 @@ TEST(Ltc, ANonPlanarLightSeenFromCloseToItsPlaneIsSampledAsItsFlattening) {
 // M^-1 P of a convex P is convex, but its computed vertices carry the rounding of the product, up to about eps
 // cond(M) of their size; check_polygon is told so (ltc.h) and accepts the transformed polygon. A square with a
 // collinear vertex on each edge under M with cond(M) up to 1e8: with only the default rounding (4 eps),
-// 2 of these 20000 views were rejected as not convex (measured by a scratch build of ltc.h without it).
+// 2 of these 20000 views are rejected as not convex.
 TEST(Ltc, TransformedPolygonsWithCollinearVerticesStayValidForIllConditionedM) {
   const PolygonLight<double> p{{-1, -1, 2}, {0.1, -1, 2}, {1, -1, 2}, {1, 0.3, 2},
                                {1, 1, 2},   {-0.2, 1, 2}, {-1, 1, 2}, {-1, -0.1, 2}};
@@ -395,7 +392,7 @@ TEST(Mis, AllEstimatorsAreUnbiasedWithAnOccluderByAStudentTTest) {
   auto f = [&](const Vec3<double>& w) { return w.cast<L>().dot(o) > 0 ? 0.0 : idealized_integrand(s, v, w); };
   // Six estimators tested at family-wise alpha = 0.01 (Sidak), plus a deliberately biased control that must be
   // rejected at the same per-test level: the noisiest estimator (one-sample balance heuristic; relative standard
-  // deviation 1.47, measured with 2e5 samples by a scratch program) scaled by 1.02. At n = 1e5 a 2% bias is then
+  // deviation 1.47, measured with 2e5 samples) scaled by 1.02. At n = 1e5 a 2% bias is then
   // ~4.3 standard errors, so the t-test has power against it; every other estimator here is less noisy.
   const int n = 100000;
   const double alpha_each = 1 - std::pow(1 - 0.01, 1.0 / 6);

@@ -119,7 +119,7 @@ TEST(MultiStart, FindsAGlobalMinimumOfHimmelblauFromEverySeed) {
     ASSERT_GE(which, 0) << "seed " << seed << " ended at " << r.x[0] << ", " << r.x[1];
     ++found[which];
   }
-  // Random starts spread over the basins: all four minima are found by some seed.
+  // Random starts spread over the basins: each of the four minima is reached from some seed.
   for (int m = 0; m < 4; ++m) EXPECT_GT(found[m], 0) << "minimum " << m;
 }
 

@@ -352,9 +352,9 @@ TEST(PolygonProjected, BackwardErrorAfterTwoIterationsOnRandomDecentralCases) {
 }
 
 // The Section 5 sampler and Arvo 1995 "map random numbers to directions in exactly the same manner" (Sec. 5).
-// On the same fan: Section 5 splits the fan's edges wider than 120 degrees (make_polygon_fan_view, for the nearly
-// antipodal vertices of fuzz_polygon_solid_angle_double 2a3027c9), a different triangulation from Arvo's, so
-// those lights map the square differently (both uniform in solid angle) and are not compared here.
+// On the same fan: Section 5 splits the fan's edges wider than 120 degrees (make_polygon_fan_view, so that no fan
+// triangle has nearly antipodal vertices), a different triangulation from Arvo's, so those lights map the square
+// differently (both uniform in solid angle) and are not compared here.
 TEST(PolygonSolidAngle, MapsRandomNumbersLikeArvo1995) {
   std::mt19937_64 rng(31);
   std::uniform_real_distribution<double> U(0, 1);
@@ -477,8 +477,8 @@ template <class T> L cone_conditioning(const PolygonLightGeometry<T>& g, bool cl
 // Section 5 (plain and clipped) seen from a shading point close to the light's plane, 1e-2 to 1e-14 of the
 // light's size off it: the fan triangles are nearly hemispheres, and clipped, the horizon edge's two ends are
 // nearly antipodal. Every sample must lie in the light's cone up to 64 eps kappa (kappa: cone_conditioning).
-// Before the half-angle arc step and the clipped fan's root at the horizon midpoint (polygon_solid_angle.h),
-// 29 (plain) and 35 (clipped) of the 188 double lights had samples outside, up to 1.6e-8 and 0.96 rad (float:
+// Without the half-angle arc step and the clipped fan's root at the horizon midpoint (polygon_solid_angle.h),
+// 29 (plain) and 35 (clipped) of the 188 double lights have samples outside, up to 1.6e-8 and 0.96 rad (float:
 // 6 and 10 of 70, up to 4.7e-4 and 0.97 rad).
 TYPED_TEST(PolygonKernels, SolidAngleSamplesLieInsideTheLightSeenFromCloseToItsPlane) {
   using T = TypeParam;
@@ -541,12 +541,12 @@ template <class T> L girard_solid_angle(const PolygonLightGeometry<T>& g) {
   return 2 * kPi<L> - turns;
 }
 
-// A strip 6 wide and 3.9e11 long seen from 8 off its plane (fuzz_polygon_solid_angle_double 2a3027c9, the recorded
-// geometry): all seven vertices lie within 2.5e-10 rad of +-y, so a fan triangle with two vertices at one end and one
-// at the other had Eq. 13's denominator G1 + G2 = -2 + 2, rounding noise for a true value of ~1e-20. Before the fan
-// split its edges wider than 120 degrees (make_polygon_fan_view, polygon_solid_angle.h) the solid angle came out as
-// 3.748 instead of 0.686, plain and clipped, and 3339 of 4225 samples on a grid lay outside the light, up to
-// 0.0215 rad (tol 1.8e-4 plain, 6.9e-4 clipped); now 0.68581742520005 (relative error ~1e-15) and none outside.
+// A strip 6 wide and 3.9e11 long seen from 8 off its plane: all seven vertices lie within 2.5e-10 rad of +-y, so a
+// fan triangle with two vertices at one end and one at the other has Eq. 13's denominator G1 + G2 = -2 + 2, rounding
+// noise for a true value of ~1e-20. Splitting the fan's edges wider than 120 degrees (make_polygon_fan_view,
+// polygon_solid_angle.h) keeps such triangles out: the solid angle is 0.68581742520005 (relative error ~1e-15) and
+// no grid sample lies outside. Without the split it is 3.748, plain and clipped, and 3339 of the 4225 samples lie
+// outside the light, up to 0.0215 rad (tol 1.8e-4 plain, 6.9e-4 clipped).
 TEST(PolygonSolidAngle, ALongStripWhoseVerticesAreNearlyAntipodalSeenFromX) {
   using T = double;
   PolygonLightGeometry<T> g;
@@ -586,12 +586,12 @@ TEST(PolygonSolidAngle, ALongStripWhoseVerticesAreNearlyAntipodalSeenFromX) {
   }
 }
 
-// A sliver triangle 3.3 long and ~6e-14 wide, seen from 0.84 (fuzz_polygon_solid_angle_double c8680af4, the recorded
-// geometry): its two long edges are 146 degrees wide and lie on one great circle with opposite inward normals, so
-// the fan split of make_polygon_fan_view, taking the midpoint's great circle from whichever edge plane held both
-// ends best, put one edge's midpoint at the other's antipode. The double view then had a solid angle of 6.26 sr
-// (the sliver's is ~6e-17: long double gives 5.9e-17) and its samples lay up to 0.7 rad off the sliver's arc. Now the
-// split midpoints of both edges agree, and the double view's solid angle is at most 1e-15 sr or it declines.
+// A sliver triangle 3.3 long and ~6e-14 wide, seen from 0.84: its two long edges are 146 degrees wide and lie on one
+// great circle with opposite inward normals. The fan split of make_polygon_fan_view must give both edges the same
+// midpoint; a midpoint's great circle taken from whichever edge plane holds both ends best puts one edge's midpoint
+// at the other's antipode, and the double view then has a solid angle of 6.26 sr (the sliver's is ~6e-17: long
+// double gives 5.9e-17) and samples up to 0.7 rad off the sliver's arc. The double view's solid angle must be at
+// most 1e-15 sr, or it declines.
 TEST(PolygonSolidAngle, ASliversTwoLongEdgesOnOneGreatCircleAreSplitAtTheSameMidpoint) {
   PolygonLightGeometry<double> g;
   g.light = PolygonLight<double>{{1, -2, 1},
@@ -630,11 +630,11 @@ TEST(PolygonSolidAngle, ASliversTwoLongEdgesOnOneGreatCircleAreSplitAtTheSameMid
     }
 }
 
-// The class of 2a3027c9: random convex strips 0.5..5.5 wide and 1..1e14 long in the plane z = 0, seen from up to 10
-// off the plane near their middle, random normals. Before the split of wide fan edges (polygon_solid_angle.h, on
-// e03f31c), 12056 samples of a 17 x 17 grid (plain and clipped, 569 lights) lay outside by more than 64 eps kappa,
-// and the solid angle was off by up to a factor 134; now none, and within 6.1e-14 of Girard's (where that exceeds
-// 1e-6 sr; below, Girard's formula in long double loses its digits).
+// The long strip above as a class: random convex strips 0.5..5.5 wide and 1..1e14 long in the plane z = 0, seen from
+// up to 10 off the plane near their middle, random normals. No sample of a 17 x 17 grid (plain and clipped) lies
+// outside by more than 64 eps kappa, and the solid angle is within 6.1e-14 of Girard's (where that exceeds 1e-6 sr;
+// below, Girard's formula in long double loses its digits). Without the split of wide fan edges
+// (polygon_solid_angle.h) 12056 samples of 569 lights lie outside and the solid angle is off by up to a factor 134.
 TEST(PolygonSolidAngle, LongStripsSeenFromCloseByKeepTheirSolidAngleAndTheirSamples) {
   using T = double;
   std::mt19937_64 rng(7);
@@ -690,13 +690,13 @@ TYPED_TEST(PolygonKernels, ThinPolygonsArePlanarRelativeToTheirWidth) {
   const PolygonLight<T> strip{Vec3<T>(-1, 0, 1), Vec3<T>(1, 0, 1), Vec3<T>(1, w, 1), Vec3<T>(-1, w, 1)};
   EXPECT_EQ(check_polygon(strip, &message), NoSample::kNone) << message;
   EXPECT_TRUE(sample_polygon_solid_angle(geom<T>(Vec3<T>::Zero(), Vec3<T>(0, 0, 1), strip), Vec2<T>(0.3, 0.6)).valid());
-  // The same strip with one corner off its plane by a tenth of its width (far below the old tolerance of
-  // 8 sqrt(eps) times the diameter): not coplanar.
+  // The same strip with one corner off its plane by a tenth of its width: not coplanar (a tolerance of
+  // 8 sqrt(eps) times the diameter would accept it).
   PolygonLight<T> bent = strip;
   bent.vertices[2].z() += w / 10;
   EXPECT_EQ(check_polygon(bent, &message), NoSample::kInvalidGeometry);
   EXPECT_NE(message.find("not coplanar"), std::string::npos) << message;
-  // fuzz_polygon_solid_angle_double 4252de58...: width 11, diameter 1.3e8, one vertex 7.9 off the plane.
+  // A kite of width 11 and diameter 1.3e8 with one vertex 7.9 off the plane: not coplanar.
   if constexpr (!std::is_same_v<T, float>) {
     const PolygonLight<T> kite{Vec3<T>(7.9375, 0, 2), Vec3<T>(1 - eps / 2, -6, 0), Vec3<T>(0, 2, 0), Vec3<T>(0, -8, 0),
                                Vec3<T>(0, 0, -134217728)};
@@ -709,8 +709,7 @@ TYPED_TEST(PolygonKernels, ThinPolygonsArePlanarRelativeToTheirWidth) {
   EXPECT_NE(message.find("narrower than its planarity tolerance"), std::string::npos) << message;
   for (NoSample r : all_reasons(geom<T>(Vec3<T>(0, -1, 0), Vec3<T>(0, 0, 1), sliver)))
     EXPECT_EQ(r, NoSample::kZeroSize);
-  // fuzz_polygon_solid_angle_double 6815131d...: eight vertices within 1e-16 of a line (an ellipse squashed to
-  // rounding), coordinates ~2.
+  // Eight vertices within 1e-16 of a line (an ellipse squashed to rounding), coordinates ~2: a sliver.
   if constexpr (std::is_same_v<T, double>) {
     const PolygonLight<T> squashed{Vec3<T>(6.0000000190264611e-30, 2.0000000063421537e-30, -3.0000000095132306e-30),
                                    Vec3<T>(5.1213203597997434e-30, -1.4142135623730949, -1.4142135623730949),
@@ -724,16 +723,16 @@ TYPED_TEST(PolygonKernels, ThinPolygonsArePlanarRelativeToTheirWidth) {
   }
 }
 
-// check_polygon forgives a reflex turn only as far as the vertices' rounding explains it. Its old tolerance was a
-// length (8 sqrt(eps) of the width), so a notch behind a short edge passed, and every kernel's inside test (the
-// planes through the edges) then cut a slice off the light that the samplers still sampled (fuzz_ltc_double
-// a8864f7e..., d3e18c5b..., 1e7d91f3..., issue 7). A vertex collinear up to rounding stays valid.
+// check_polygon forgives a reflex turn only as far as the vertices' rounding explains it. A tolerance that is a
+// length (8 sqrt(eps) of the width) passes a notch behind a short edge, and every kernel's inside test (the planes
+// through the edges) then cuts a slice off the light that the samplers still sample. A vertex collinear up to
+// rounding stays valid.
 TYPED_TEST(PolygonKernels, AReflexNotchBehindAShortEdgeIsNotConvexButACollinearVertexWithinRoundingIs) {
   using T = TypeParam;
   const T eps = std::numeric_limits<T>::epsilon();
   std::string message;
   // A unit square at z = 1 with a notch of depth h at its corner (0, 0): the vertex (h, h) between (0, 1) and
-  // (0, 0). The turn there is reflex with s = -h; the old tolerance, about 8 sqrt(eps) here, accepted h below it.
+  // (0, 0). The turn there is reflex with s = -h; a length tolerance, about 8 sqrt(eps) here, accepts h below it.
   const T h = std::is_same_v<T, float> ? T(1e-4) : T(1e-9);
   ASSERT_LT(h, T(8) * std::sqrt(eps));
   const PolygonLight<T> notch{Vec3<T>(0, 0, 1), Vec3<T>(1, 0, 1), Vec3<T>(1, 1, 1), Vec3<T>(0, 1, 1), Vec3<T>(h, h, 1)};
@@ -747,7 +746,7 @@ TYPED_TEST(PolygonKernels, AReflexNotchBehindAShortEdgeIsNotConvexButACollinearV
                               Vec3<T>(0, 1, 1)};
     EXPECT_EQ(check_polygon(mid, &message), NoSample::kNone) << double(y) << ": " << message;
   }
-  // fuzz_ltc_double 1e7d91f3...: an edge of length 7.5e-9 reflex by 0.016 rad in a light of size 16.
+  // An edge of length 7.5e-9 reflex by 0.016 rad in a light of size 16.
   if constexpr (!std::is_same_v<T, float>) {
     const PolygonLight<T> fuzzed{Vec3<T>(T(-7.4505805969238281e-09), 0, 0), Vec3<T>(0, 0, T(15.99951171875)),
                                  Vec3<T>(T(15.99951171875), T(-0.375), -1), Vec3<T>(0, 0, 0)};
@@ -759,8 +758,8 @@ TYPED_TEST(PolygonKernels, AReflexNotchBehindAShortEdgeIsNotConvexButACollinearV
 // A spike: an edge that runs back along the previous one. Triangle (0,0), (1,0), (0,1) with an extra vertex an ulp
 // before (1,0) on the first edge, so the edge (1,0) -> (1 - eps, 0) turns back by pi: its turn atan2(+0, c < 0)
 // counts as +pi, the reflex turn after it is within the vertices' rounding, and the turns still add up to one
-// revolution. Every kernel's plane through that edge then faces outwards (fuzz_polygon_projected_double
-// da03856c..., fuzz_polygon_solid_angle_double 3091f781..., issue 7). Without the spike test check_polygon passed it.
+// revolution. Every kernel's plane through that edge then faces outwards. Without the spike test check_polygon
+// passes it.
 TYPED_TEST(PolygonKernels, ASpikeIsNotConvex) {
   using T = TypeParam;
   const T eps = std::numeric_limits<T>::epsilon();
@@ -776,8 +775,8 @@ TYPED_TEST(PolygonKernels, ASpikeIsNotConvex) {
 }
 
 // A polygon wound twice is not simple even where an edge within rounding of a point (here 9e-308 long, out of the
-// plane) makes its turns underflow: they came out as 0, the turning number as one revolution, and the light was
-// sampled 0.16 rad outside itself (fuzz_polygon_solid_angle_double b6ebf498, issue 7).
+// plane) makes its turns underflow: taken as 0, they make the turning number one revolution, and the light is
+// sampled 0.16 rad outside itself.
 TEST(PolygonKernels, APolygonWoundTwiceWithASubnormalEdgeIsNotSimple) {
   const double m = std::numeric_limits<double>::min();
   const PolygonLight<double> twice{Vec3<double>(0, -2, -m),     Vec3<double>(0, 2, -2),
@@ -791,8 +790,8 @@ TEST(PolygonKernels, APolygonWoundTwiceWithASubnormalEdgeIsNotSimple) {
 
 // A reflex turn hidden behind an edge along the normal is still a reflex turn: the turns at the edge's two ends
 // are 0 (its projection onto the plane is 0), so testing each vertex with its own two edges passed this pentagon as
-// convex, and the biased projected sampler put a sample 0.016 rad outside (fuzz_polygon_projected_double
-// c42d6431..., issue 7). The turn is taken between the edges either side of it.
+// convex, and the biased projected sampler puts a sample 0.016 rad outside. The turn is taken between the edges
+// either side of it.
 TYPED_TEST(PolygonKernels, AReflexTurnBehindAnEdgeAlongTheNormalIsNotConvex) {
   using T = TypeParam;
   const T dm = std::numeric_limits<T>::denorm_min();
@@ -807,9 +806,9 @@ TYPED_TEST(PolygonKernels, AReflexTurnBehindAnEdgeAlongTheNormalIsNotConvex) {
 
 // A notch of edges shorter than sqrt(denorm_min) is a reflex turn all the same: a unit square whose corner at the
 // origin is notched in by t = sqrt(denorm_min) / 4 (2.8e-163 in double, 1e15 times its vertices' rounding) turns
-// right at (t, t). The squares in those edges' lengths underflowed to 0, so they were dropped as shorter than their
-// rounding and the joined turn of their neighbours, a left one, passed as convex. Edges are scaled by a power of
-// two before their lengths and turns are taken; the same square cut by a convex chamfer there is valid.
+// right at (t, t). The squares in those edges' lengths underflow to 0, so unscaled they are dropped as shorter than
+// their rounding and the joined turn of their neighbours, a left one, passes as convex. Edges are scaled by a power
+// of two before their lengths and turns are taken; the same square cut by a convex chamfer there is valid.
 TYPED_TEST(PolygonKernels, AReflexNotchOfEdgesShorterThanTheSquareRootOfDenormMinIsNotConvex) {
   using T = TypeParam;
   const T t = std::sqrt(std::numeric_limits<T>::denorm_min()) / T(4);
@@ -828,10 +827,10 @@ TYPED_TEST(PolygonKernels, AReflexNotchOfEdgesShorterThanTheSquareRootOfDenormMi
 
 // A light planar up to the subnormal grid: the triangle (1, 0, 0), (0, 0, 0), (0, 4, -12) with its corner at the
 // origin split into three vertices denorm_min apart, one of them denorm_min off the plane along z. The plane
-// through x and the edge along z cut the light in two, and the subnormal grid turned the plane of the edge along x
-// by 0.08 rad, so pdf() was 0 at the projected sampler's directions up to 0.01 rad inside (found by
-// fuzz_polygon_projected_double a5885e87..., issue 7). The edges are taken in the light's plane and scaled, and an
-// edge that is a point in the plane up to rounding takes its predecessor's plane (polygon_inward_planes).
+// through x and the edge along z would cut the light in two, and the subnormal grid turns the plane of the edge along
+// x by 0.08 rad, so a pdf() from those planes is 0 at the projected sampler's directions up to 0.01 rad inside. The
+// edges are taken in the light's plane and scaled, and an edge that is a point in the plane up to rounding takes its
+// predecessor's plane (polygon_inward_planes).
 TYPED_TEST(PolygonKernels, PdfIsPositiveInsideALightWhoseCornerIsSplitIntoVerticesDenormMinApart) {
   using T = TypeParam;
   const T dm = std::numeric_limits<T>::denorm_min();
@@ -867,8 +866,8 @@ TYPED_TEST(PolygonKernels, PdfIsPositiveInsideALightWhoseCornerIsSplitIntoVertic
 
 // The pentagon (-1, 0) (0, -1) (0.5, 0) (0, 2) (0, 0) in the plane x = 0 turns right by 90 degrees at the origin,
 // where three more vertices lie within 1e-307 of it: an edge along x (x = 4.4e-308) and two edges whose squared
-// lengths underflow. Each vertex's own turns were 0 there, and the clipped solid-angle kernel sampled the light
-// 0.26 rad outside itself (fuzz_polygon_solid_angle_double 641e4492..., issue 7).
+// lengths underflow. Each vertex's own turns are 0 there; passed as convex, the light is sampled 0.26 rad outside
+// itself by the clipped solid-angle kernel.
 TEST(PolygonKernels, AReflexCornerBehindSubnormalEdgesIsNotConvex) {
   const PolygonLight<double> hidden{
       Vec3<double>(0, 0, 0),
@@ -890,9 +889,8 @@ TEST(PolygonKernels, AReflexCornerBehindSubnormalEdgesIsNotConvex) {
 
 // check_polygon accepts vertices off the light's plane up to its planarity tolerance (about 8 sqrt(eps) of the
 // width). A shading point closer to the plane than that, with vertices on both sides of it, does not see a
-// convex spherical polygon, and which side of the light it is on is undetermined: edge-on
-// (fuzz_polygon_projected_double fe6b6d80..., fuzz_polygon_solid_angle_double 5c7b9846..., issue 7). A unit square with
-// one corner lifted by h = sqrt(eps), within the tolerance; the centroid's plane is near z = h / 4.
+// convex spherical polygon, and which side of the light it is on is undetermined: edge-on. A unit square with one
+// corner lifted by h = sqrt(eps), within the tolerance; the centroid's plane is near z = h / 4.
 TYPED_TEST(PolygonKernels, AShadingPointWithinTheLightsNonPlanarityWithVerticesOnBothSidesSeesItEdgeOn) {
   using T = TypeParam;
   const T h = std::sqrt(std::numeric_limits<T>::epsilon());
@@ -909,8 +907,7 @@ TYPED_TEST(PolygonKernels, AShadingPointWithinTheLightsNonPlanarityWithVerticesO
 
 // Sec. 3.1 / Fig. 3b: the sectors cover the whole light when an edge of sign 0 lies inside a chain. A triangle
 // with a collinear extra vertex (a doubled vertex 2.2e-16 away, on the same vertical line as the clip point), cut
-// by the horizon: the inner chain used to stop at that edge, A_Sigma 9.3e-22 instead of 1.57e-4 (fuzz_ltc_double
-// c37ad58b with M = I, issue 7).
+// by the horizon: an inner chain that stops at that edge gives A_Sigma 9.3e-22 instead of 1.57e-4.
 TEST(PolygonProjected, ProjectedSolidAngleMatchesLambertWithADoubledVertexInsideAChain) {
   const PolygonLightGeometry<double> g =
       geom<double>({-5.6568542494923815, 0.75000000000000122, 0.25}, {0, 2.1588771306901901e-16, -1},
@@ -925,9 +922,8 @@ TEST(PolygonProjected, ProjectedSolidAngleMatchesLambertWithADoubledVertexInside
 }
 
 // A light narrower than 64 eps of its coordinates' scale is too small: V_k - x is rounded to about eps of that
-// scale, and the local polygon is rounding noise (an octagon of diameter 32 seen from 1.7e17 sampled the zenith,
-// 0.64 rad outside; fuzz_polygon_projected_double 3c4c6d32, issue 7). A light 8 times as wide, 8 times the bound, is
-// sampled.
+// scale, and the local polygon is rounding noise (an octagon of diameter 32 seen from 1.7e17 is sampled at the
+// zenith, 0.64 rad outside). A light 8 times as wide, 8 times the bound, is sampled.
 TYPED_TEST(PolygonKernels, ALightNarrowerThanItsCoordinatesRoundingIsTooSmallForTheProjectedSampler) {
   using T = TypeParam;
   const T eps = std::numeric_limits<T>::epsilon();
@@ -943,10 +939,9 @@ TYPED_TEST(PolygonKernels, ALightNarrowerThanItsCoordinatesRoundingIsTooSmallFor
   }
 }
 
-// Sec. 3.1: a light around the zenith is central although an edge has n_z < 0 by rounding: a doubled vertex
-// (octagon 1a7607a0), a short edge whose line the coordinates do not place to the zenith's side (15bb13cf, x 5e-9
-// beside a vertex), and a vertex at the zenith (below); decentral, their A_Sigma was ~1e-33 instead of 0.11 and
-// 1.56 (fuzz_ltc_double with M = I, issue 7).
+// Sec. 3.1: a light around the zenith is central although an edge has n_z < 0 by rounding: a doubled vertex (an
+// octagon), a short edge whose line the coordinates do not place to the zenith's side (x 5e-9 beside a vertex),
+// and a vertex at the zenith (below); taken as decentral, their A_Sigma is ~1e-33 instead of 0.11 and 1.56.
 TEST(PolygonProjected, ProjectedSolidAngleMatchesLambertAroundTheZenithWithEdgesOfNoiseSign) {
   const PolygonLightGeometry<double> lights[] = {
       geom<double>({8.397054999316353, 3.442316484673952, 15.695498354587828},
@@ -971,8 +966,8 @@ TEST(PolygonProjected, ProjectedSolidAngleMatchesLambertAroundTheZenithWithEdges
                     {66.020560067073461, 0.87677153373943228, 13.169723593179794}}),
       // A vertex at the zenith puts the zenith on the boundary, and the central decomposition is exact: a hexagon
       // seen from 3e-5 beside a vertex, with a vertex 8 eps from the zenith (put at it) and an edge 4e-15 long whose
-      // n_z = -1e-17 is noise. The decentral case took that edge for the only inner chain, A_Sigma 4.9e-32 instead
-      // of 0.708 (fuzz_ltc_double 403f9cc0 with M = I).
+      // n_z = -1e-17 is noise. The decentral case takes that edge for the only inner chain, A_Sigma 4.9e-32 instead
+      // of 0.708.
       geom<double>({-0.1273642887492622, -10.738008116536452, 1.081344971704761},
                    {-12.677181692463837, 47.051874731980355, 8.0928367707429203},
                    {{0, -10.595186948776245, 0.99999999999999989},
@@ -992,11 +987,11 @@ TEST(PolygonProjected, ProjectedSolidAngleMatchesLambertAroundTheZenithWithEdges
 
 // Sec. 3.7 / Fig. 7a: "even with small, distant polygons, it still works" in float. The 1 cm square light 40 m
 // away (the battery's far-1cm) sampled with float has sectors 2e-4 rad wide whose inner and outer ellipses are
-// 2.5e-4 apart relative. Two defects this test caught (float, distance to the exact inverse for the same u, in
-// light widths): Eq. 6's root taken from T's entries (Blinn's formula) moved by their rounding, up to 0.43 on
-// the grid, the same with 20 iterations (now increasing_root_around); and the residual measured from s0 could not
-// resolve the last sector's tip, 1.7e-2 at u0 = 1 - 1e-4 (chi2 bin +18 sigma at 1e7 samples; now from the
-// nearer end, decentral_residual). Measured after both: 6.3e-4 worst, grid and ends.
+// 2.5e-4 apart relative. The test sees two errors (float, distance to the exact inverse for the same u, in light
+// widths): Eq. 6's root taken from T's entries (Blinn's formula) moves by their rounding, up to 0.43 on the grid,
+// the same with 20 iterations (increasing_root_around avoids it); and a residual measured from s0 cannot resolve
+// the last sector's tip, 1.7e-2 at u0 = 1 - 1e-4 (chi2 bin +18 sigma at 1e7 samples; decentral_residual measures
+// from the nearer end). With both: 6.3e-4 worst, grid and ends.
 // The bound 5e-3 leaves room for the float area function's own error (5e-4 of a sector's area, measured).
 // The reference is long double on the same (float-rounded) light.
 TEST(PolygonProjected, FloatSamplesOfASmallFarLightStayWithinHalfAPercentOfItsWidthOfTheExactInverse) {
@@ -1027,8 +1022,8 @@ TEST(PolygonProjected, FloatSamplesOfASmallFarLightStayWithinHalfAPercentOfItsWi
   EXPECT_LE(worst, 5e-3L);
 }
 
-// The float limit behind the battery's far-1mm failures (registry_polygon.cpp, polygon_known_limitation): float's
-// unit vectors near the direction of a light 40 m away are 6e-8 rad apart, 1/426 of a 1 mm light's width, so
+// The float limit behind the battery's far-1mm failures (polygon_known_limitation in validation/catalogue/polygon.cpp):
+// float's unit vectors near the direction of a light 40 m away are 6e-8 rad apart, 1/426 of a 1 mm light's width, so
 // even Turk's area sampling (float only in the point and its normalisation) returns directions on a coarse
 // lattice, and some round to just outside the light. At 1 cm the lattice is 10x finer and nearly every sample
 // is distinct. Measured (seed 1, 1e6 samples): 1 mm 343292 distinct, 541 with pdf 0; 1 cm 984300 and 49.

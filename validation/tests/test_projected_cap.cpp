@@ -237,7 +237,7 @@ TEST(ProjectedCapQuintic, Case2PiecesMeetExactlyAtTheSeam) {
     EXPECT_NEAR(after.x(), v.t_x, 1e-12L) << u1;
     EXPECT_LT((before - after).norm(), 1e-12L) << u1;
   }
-  // The old worst case: one piece, pdf x area element = 1.
+  // At the search's worst case: one piece, pdf x area element = 1.
   const Vec2<Real> u(0.254194L, 0.889313L);
   const auto s = sample_projected_spherical_cap<Real>(v, u);
   ASSERT_TRUE(s.valid());
@@ -251,9 +251,9 @@ TEST(ProjectedCapQuintic, Case2PiecesMeetExactlyAtTheSeam) {
   EXPECT_LT((back - u).cwiseAbs().maxCoeff(), 1e-12L);
 }
 
-// With the published ranges the Case-3 lune's top was never sampled (E[cos/pdf; hit] 1.1e-4 low in case3): the
-// quintic's abscissa at left-area A_D missed -t_x. Now u0 = 0 reaches the cut, i.e. the top of the lune, which lies
-// on the light's boundary, in every precision, and u0 -> 1 reaches the left end of the disk.
+// u0 = 0 reaches the cut, i.e. the top of the Case-3 lune, which lies on the light's boundary, in every precision,
+// and u0 -> 1 reaches the left end of the disk. With the published ranges the quintic's abscissa at left-area A_D
+// misses -t_x and the lune's top is never sampled (E[cos/pdf; hit] 1.1e-4 low in case3).
 template <class T> void expect_case3_lune_top_reached(const char* name) {
   const ProjectedCapConfig c = config(name);
   const SphereLightGeometry<T> g{
@@ -310,8 +310,8 @@ TEST(ProjectedCapFrame, OverheadLightGivesTheSameSamplesInDoubleAndLongDouble) {
 // ---- float accuracy of the sampling path --------------------------------------------------------------------
 
 // Largest |pdf_float / pdf_long_double - 1| of the samples at the same (float) primary samples, and the same with
-// w_z recomputed naively as sqrt(1 - w_x^2 - w_y^2) from the float sample's own local w_x, w_y (what the kernel
-// did before the sum-of-squares heights of disk_to_local).
+// w_z recomputed naively as sqrt(1 - w_x^2 - w_y^2) from the float sample's own local w_x, w_y (the lift that
+// disk_to_local's sum-of-squares heights avoid).
 struct FloatPdfError {
   double kernel = 0, naive = 0, u0 = 0, u1 = 0, wz = 0;
 };
@@ -351,19 +351,17 @@ TEST(ProjectedCapFloat, SamplePdfsNearTheHorizonKeepTheirDigits) {
   // A float sample's pdf against the long double sample's at the same primary sample. Even an exact float warp
   // differs by the float sample's position error (a few eps in the left-area) times the log-derivative of the
   // density, which is large near the horizon (w_z -> 0): for "huge" ~3e-6 at w_z = 0.044 (estimated from the
-  // intermediate values; measured 5.3e-6). Measured (20000 samples per configuration, 2026-12-01): at most
-  // 1.05e-5 = 176 eps_float (near-touching, below) in all configurations but near-touching-case3 (then 4.0e-5, now
-  // 1.75e-5: see below). With
-  // only the heights of disk_to_local written without cancellation (not yet the left-areas, right-areas and
-  // r_y^2 - h^2) it was 1.7e-4 (tangent-horizon), 2.9e-4 (case2), 3.2e-4 (huge); the naive lift of the same
-  // samples gives up to 1 (case3-fig9) and 3.4 (tiny-straddling: w_x ~ 1 - 1e-6 leaves w_z no digit). Bound:
-  // 256 eps_float = 3.1e-5, in every configuration.
-  // near-touching-case3 (a Case-3 cap of 87 deg): with Case 3's w_x = sqrt(1 - w_y^2 - w_z^2) it measured 4.0e-5
-  // (bound was 1e-4); with w_x^2 = d_x^2 + (1 - s_y^2) d_y^2 + (1 - k^2) d_z^2 (issue 7, projected_cap.h header)
-  // 1.75e-5 (2026-12-02), so it now has the common bound. near-touching (d = 1.001
-  // r): 1.05e-5, cos(theta_max) = sqrt(1 - (r/d)^2) itself is that far off; inherent for general positions, where
-  // d is only known to eps d (writing it sqrt((d - r)(d + r)) / d fixed this axis-aligned configuration and made
-  // the recorded worst case precision-sphere-solid-angle-float-angle 8% worse, so sphere.h keeps 1 - (r/d)^2).
+  // intermediate values; measured 5.3e-6). Measured (20000 samples per configuration): at most 1.75e-5
+  // (near-touching-case3) and 1.05e-5 = 176 eps_float (near-touching) in the others. Bound: 256 eps_float =
+  // 3.1e-5, in every configuration. With only the heights of disk_to_local written without cancellation (not the
+  // left-areas, right-areas and r_y^2 - h^2) it is 1.7e-4 (tangent-horizon), 2.9e-4 (case2), 3.2e-4 (huge); the
+  // naive lift of the same samples gives up to 1 (case3-fig9) and 3.4 (tiny-straddling: w_x ~ 1 - 1e-6 leaves w_z
+  // no digit).
+  // near-touching-case3 (a Case-3 cap of 87 deg): 1.75e-5 with w_x^2 = d_x^2 + (1 - s_y^2) d_y^2 + (1 - k^2) d_z^2
+  // (projected_cap.h header), 4.0e-5 with Case 3's w_x = sqrt(1 - w_y^2 - w_z^2). near-touching (d = 1.001 r):
+  // 1.05e-5, cos(theta_max) = sqrt(1 - (r/d)^2) itself is that far off; inherent for general positions, where d is
+  // only known to eps d (writing it sqrt((d - r)(d + r)) / d fixes this axis-aligned configuration but makes the
+  // recorded worst case precision-sphere-solid-angle-float-angle 8% worse, so sphere.h keeps 1 - (r/d)^2).
   const double eps = std::numeric_limits<float>::epsilon();
   double worst_naive = 0;
   for (const ProjectedCapConfig& c : projected_cap_configs()) {
@@ -373,13 +371,13 @@ TEST(ProjectedCapFloat, SamplePdfsNearTheHorizonKeepTheirDigits) {
     worst_naive = std::max(worst_naive, e.naive);
     EXPECT_LE(e.kernel, 256 * eps) << c.name;
   }
-  EXPECT_GT(worst_naive, 1e4 * eps);  // the check sees what the old lift did
+  EXPECT_GT(worst_naive, 1e4 * eps);  // the check sees the naive lift's error
 }
 
 TEST(ProjectedCapFrame, FrameIsHorizontalForALightOverheadUpToRoundingWithATiltedNormal) {
-  // fuzz_projected_cap_double 71db744e (issue 7): normal and direction to the centre agree to rounding (d = r (1 +
-  // 2e-16), a cap of 90 deg), the normal not axis-aligned. Two Gram-Schmidt passes left x parallel to n (x.z = 1,
-  // y = 0) and a sample at n.w = -1; x = n x (w_d x n) is horizontal to rounding.
+  // Normal and direction to the centre agree to rounding (d = r (1 + 2e-16), a cap of 90 deg), the normal not
+  // axis-aligned. Two Gram-Schmidt passes leave x parallel to n (x.z = 1, y = 0) and a sample at n.w = -1;
+  // x = n x (w_d x n) is horizontal to rounding.
   const SphereLightGeometry<double> g{
       ShadingPoint<double>{Vec3<double>(-1.2669652949151753, 3.4659473398571494, 1.1334826474575876),
                            Vec3<double>(0.26696529491517529, 0.53393058983035058, -0.13348264745758764)},
@@ -400,16 +398,15 @@ TEST(ProjectedCapFrame, FrameIsHorizontalForALightOverheadUpToRoundingWithATilte
   EXPECT_GE(valid, 16);
 }
 
-// ---- Scale and the Case-3 lift (issue 7) ---------------------------------------------------------------------
+// ---- Scale and the Case-3 lift ------------------------------------------------------------------------------
 
 TEST(ProjectedCapScale, SubnormalAndHugeLightsSampleExactlyLikeTheSameLightAtUnitScale) {
   // The sampler depends on the light only through w_d and r / |c - x|, both unchanged when c - x and r are
-  // multiplied by a power of two. A light at 2^-1074 (c - x = (1, 3, -1) denorm_min, fuzz_projected_cap_double
-  // 07252d59: |c - x| rounded to 3 denorm_min gave |w_d| = 1.106 and A_E + A_D 40 % off; before the fix all 15
-  // samples of each normal below differed) and one at 2^900 (where |c - x|^2 would overflow; stableNorm avoided
-  // that already, and those passed before) must give bit-identical views, samples and densities to the unit-scale
-  // light: every coordinate below is an integer times the scale, so c - x is exact at each scale, and the view is built
-  // from (c - x) 2^-e, r 2^-e (unit_scale_geometry) in all three.
+  // multiplied by a power of two. A light at 2^-1074 (c - x = (1, 3, -1) denorm_min, where |c - x| computed at that
+  // scale rounds to 3 denorm_min, |w_d| = 1.106, A_E + A_D 40 % off and all 15 samples of each normal below differ)
+  // and one at 2^900 (where |c - x|^2 would overflow) must give bit-identical views, samples and densities to the
+  // unit-scale light: every coordinate below is an integer times the scale, so c - x is exact at each scale, and the
+  // view is built from (c - x) 2^-e, r 2^-e (unit_scale_geometry) in all three.
   const Vec3<double> c0(0, 3, 3), x0(-1, 0, 4);
   const Vec3<double> wd = (c0 - x0).normalized(), side = Vec3<double>(1, 0, 1).normalized();  // side . wd = 0
   int cases_seen[4] = {0, 0, 0, 0};
@@ -443,10 +440,9 @@ TEST(ProjectedCapScale, SubnormalAndHugeLightsSampleExactlyLikeTheSameLightAtUni
   EXPECT_GT(cases_seen[1] * cases_seen[2] * cases_seen[3], 0);
 }
 
-// A light overhead to far below rounding, the horizontal parts of w_d and n subnormal (fuzz_projected_cap_double
-// 613804bc, issue 7): x was the subnormal horizontal part over its rounded norm, (1, 1, 0) of length sqrt 2, and
-// every sample off the axis 0.11 rad outside the cap (0.41 rad from the axis against theta_max 0.298, measured on
-// ce4c71c). Geometry as the fuzzer decoded it.
+// A light overhead to far below rounding, the horizontal parts of w_d and n subnormal. x taken as the subnormal
+// horizontal part over its rounded norm is (1, 1, 0), of length sqrt 2, and puts every sample off the axis 0.11 rad
+// outside the cap (0.41 rad from the axis against theta_max 0.298).
 TEST(ProjectedCapScale, ALightOverheadToASubnormalHorizontalPartIsSampledInsideItsCap) {
   const double e = std::numeric_limits<double>::epsilon();
   SphereLightGeometry<double> g;
@@ -471,15 +467,14 @@ TEST(ProjectedCapScale, ALightOverheadToASubnormalHorizontalPartIsSampledInsideI
 }
 
 TEST(ProjectedCapCase3, SamplePdfsKeepTheirDigitsNearTheLunesFlatSide) {
-  // fuzz_projected_cap_double 71f5a077 (issue 7): a cap of 90 deg - 0.02 deg (r / d = 1 - 2^-24, v = 3.45e-4; r^2
-  // is exact in double, so the double and long double views agree to rounding) with its centre just below the
-  // horizon. Samples near u0 = 0 lie next to the lune's flat side, w_x ~ v, where the lift 1 - w_y^2 - w_z^2
-  // lost eps / w_x^2 = 1.9e-9 of the density (measured before the fix, max over the grid below: 9.2e-10 exact,
-  // 1.9e-9 quintic; the harness allows 16 eps). With the lift as a sum of squares (projected_cap.h, header) every
-  // factor of the density is a product or quotient of quantities known to a few eps, without amplification: a few
-  // tens of eps at most, bound kTolUlps = 64 eps (measured after the fix: at most 9.3 eps), for the sample's pdf
-  // against long double at the same u and against pdf() of its own direction (the density is smooth there: its
-  // log-gradient times the direction's few-eps rounding is below an eps).
+  // A cap of 90 deg - 0.02 deg (r / d = 1 - 2^-24, v = 3.45e-4; r^2 is exact in double, so the double and long
+  // double views agree to rounding) with its centre just below the horizon. Samples near u0 = 0 lie next to the
+  // lune's flat side, w_x ~ v, where the lift 1 - w_y^2 - w_z^2 loses eps / w_x^2 = 1.9e-9 of the density (max over
+  // the grid below: 9.2e-10 exact, 1.9e-9 quintic; the harness allows 16 eps). With the lift as a sum of
+  // squares (projected_cap.h, header) every factor of the density is a product or quotient of quantities known to
+  // a few eps, without amplification: a few tens of eps at most, bound kTolUlps = 64 eps (measured: at most
+  // 9.3 eps), for the sample's pdf against long double at the same u and against pdf() of its own direction (the
+  // density is smooth there: its log-gradient times the direction's few-eps rounding is below an eps).
   const double eps = std::numeric_limits<double>::epsilon();
   for (double h : {-1e-200, -1e-17, -1e-9}) {
     const SphereLightGeometry<double> g{ShadingPoint<double>{Vec3<double>::Zero(), Vec3<double>(0, 0, 1)},
@@ -506,12 +501,12 @@ TEST(ProjectedCapCase3, SamplePdfsKeepTheirDigitsNearTheLunesFlatSide) {
 }
 
 TEST(ProjectedCapInverse, PdfGivesACase2DiskPieceBelowALeftAreaUlpItsOwnDensity) {
-  // Confirming campaign of issue 7 (fuzz_projected_cap_double 30c73384): an overhead light touching x (h = r_y =
-  // 1 - 5.7e-14 up to 1e-16), Case 2 with a disk piece of area A_D = 6.4e-16 (half-cap of 9.9e-6 rad around the
-  // local x axis), less than two ulps of pi in left-area, and tau = 1 - 2^-53 (the quintic's disk piece then has
-  // 0.55 x the ellipse's density: its u0 share is quantised). pdf() compared the ellipse piece's left-areas near pi
-  // and gave the ellipse's density to 29 of the 50 directions below (theta in [0.5, 1) of the piece's radius, the
-  // outer part); it compares right-areas now. Every one must get the disk piece's density, the sampler's.
+  // An overhead light touching x (h = r_y = 1 - 5.7e-14 up to 1e-16), Case 2 with a disk piece of area
+  // A_D = 6.4e-16 (half-cap of 9.9e-6 rad around the local x axis), less than two ulps of pi in left-area, and
+  // tau = 1 - 2^-53 (the quintic's disk piece then has 0.55 x the ellipse's density: its u0 share is quantised).
+  // pdf() compares right-areas here: comparing the ellipse piece's left-areas near pi gives the ellipse's density
+  // to 29 of the 50 directions below (theta in [0.5, 1) of the piece's radius, the outer part). Every one must get
+  // the disk piece's density, the sampler's.
   const SphereLightGeometry<double> g{
       ShadingPoint<double>{Vec3<double>(-8.9672072669915119e+26, 8.7416627936820459e+26, -1.4445920849195454e+26),
                            Vec3<double>(-3.1900322795701238e-07, -0.70833782255786737, -0.70587359288606144)},

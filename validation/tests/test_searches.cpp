@@ -195,8 +195,8 @@ TEST(Searches, MergingShardsTakesTheWorstAndSumsTheWork) {
 // The polygon-backward searches cover exactly the sectors real polygons have (Peters 2021 Sec. 3.6 searches
 // "test cases" of inner/outer ellipse, sector and target): every sector of random decentral triangles, rotated so
 // that s0 = (1, 0) and written in the search's parameters, is a valid point with the kernel's own backward error;
-// and the search's first worst case (7.8e-2, recorded before 2026-12-01), whose sector contains the direction
-// where the outer edge's great circle meets the horizon, is not a valid point.
+// and a sector containing the direction where the outer edge's great circle meets the horizon (the worst case the
+// search reaches without its edge-half constraint, 7.8e-2) is not a valid point.
 TEST(PolygonBackwardSearch, EverySectorOfARealPolygonIsAPointOfTheSearchAndNoOtherIs) {
   using L = long double;
   const Search s = *find_search("polygon-backward-k2");
@@ -224,8 +224,7 @@ TEST(PolygonBackwardSearch, EverySectorOfARealPolygonIsAPointOfTheSearchAndNoOth
     ++checked;
   }
   EXPECT_GT(checked, 1900);
-  // The old worst case (data/worst-cases/polygon-backward-k2.json before 2026-12-01, to 17 digits): still 7.8e-2
-  // without the constraint, which is what makes it NaN now.
+  // That worst case, to 17 digits: its error is 7.8e-2 without the constraint, which makes it NaN.
   const std::vector<L> old{1.5707963267948966L,   -1.5720280146623582L, 1.5644003505118398L,
                            -0.80375905809977888L, 179.91251265643641L,  0.2705798324036342L};
   EXPECT_TRUE(std::isnan(s.objective(old)));

@@ -91,9 +91,8 @@ TYPED_TEST(SphereKernels, SamplesAreUnitDirectionsInsideTheConeWithMatchingPdf) 
       geometry<T>(Vec3<T>(0.1, -0.2, 0), Vec3<T>(0, 0.3, 1), Vec3<T>(1, 2, 2.5), T(0.7)));
 }
 
-// A sphere 0.9 of the largest finite T away (d / r = 3). fuzz_sphere_float 62328c27... (d = 3.4e38: a zero direction,
-// UBSan division by zero in renormalized; issue 7) was lost with its machine before it was kept. This geometry
-// states the property; it does not reproduce that input (the kernel passes it unchanged).
+// A sphere 0.9 of the largest finite T away (d / r = 3): |p - x| and the density stay finite, and no sample is a
+// zero direction (which renormalized would divide by).
 TYPED_TEST(SphereKernels, SamplesOfASphereNearTheLargestFiniteDistanceAreUnitDirectionsWithMatchingPdf) {
   using T = TypeParam;
   const T m = std::numeric_limits<T>::max();
@@ -132,10 +131,10 @@ TEST(CubeRoot, IsWithinHalfAnUlpInFloatAndOneUlpInDouble) {
   EXPECT_TRUE(std::isnan(warpcheck::cube_root(std::numeric_limits<double>::quiet_NaN())));
 }
 
-// core.h's division-free x^(2/3) for float (the float projected-cap quintic's root, issue 9) against cbrtl, over every
-// float of one period [1, 8): its steps scale exactly with x -> 8 x (checked below across the exponent range where
-// x and the result are normal floats), so this covers every such float. Measured: 0.5228 ulp (cube_root(x * x),
-// which it replaced for float, rounds x * x first).
+// core.h's division-free x^(2/3) for float (the float projected-cap quintic's root) against cbrtl, over every float
+// of one period [1, 8): its steps scale exactly with x -> 8 x (checked below across the exponent range where x and
+// the result are normal floats), so this covers every such float. Measured: 0.5228 ulp (cube_root(x * x) rounds
+// x * x first).
 TEST(CubeRootSquaredForFloat, IsWithinAnUlpOverEveryFloatOfOnePeriodAndScalesExactlyByEight) {
   double worst = 0;
   for (float x = 1.0f; x < 8.0f; x = std::nextafter(x, 9.0f)) {

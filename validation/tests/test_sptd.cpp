@@ -104,8 +104,8 @@ TEST(SptdPivot, SphereFormAgreesWithEq2AndBothAreInvolutions) {
 
 // A pivot within an ulp of the sphere, r = 1 - eps/2, and w on its direction p: g(w) = -p and Eq. 4 gives
 // ((1 + r) / (1 - r))^2, whatever w's length (1 +- a few eps, as any rounded unit vector). The plain difference
-// r_p - w is of the order of that length error there: the kernel gave g = +p, Jacobian Inf for |w| = r, and for
-// the vectors of fuzz_sptd_double 262911f1 g = 0 (0 / 0, UBSan float-divide-by-zero), issue 7.
+// r_p - w is of the order of that length error there: it gives g = +p, Jacobian Inf for |w| = r, and for the
+// vectors below g = 0 (0 / 0, UBSan float-divide-by-zero).
 template <class T> void expect_on_pivot_direction_maps_to_antipode() {
   const T eps = std::numeric_limits<T>::epsilon();
   const Vec3<T> rp(T(0), T(0), T(1) - eps / T(2));
@@ -125,10 +125,9 @@ template <class T> void expect_on_pivot_direction_maps_to_antipode() {
 TEST(SptdPivot, SphereFormMapsThePivotsDirectionToItsAntipodeForAPivotWithinAnUlpOfTheSphere) {
   expect_on_pivot_direction_maps_to_antipode<float>();
   expect_on_pivot_direction_maps_to_antipode<double>();
-  // The vectors of fuzz_sptd_double 262911f1: r_p with 1 - |r_p| = 1.1e-16 and the uniform SPTD over the whole
-  // sphere, whose image is the whole sphere around C's axis w = (-1.49e-8, 0, -1) (|w| = 1 + 1.1e-16), sampled at
-  // u = 0. w is 2e-24 rad off p (with rounding, |w x p| < 1e-23), and g stretches by (1 + r) / (1 - r) = 1.8e16
-  // at p: g(w) lies within 1e-6 rad of -p.
+  // r_p with 1 - |r_p| = 1.1e-16 and the uniform SPTD over the whole sphere, whose image is the whole sphere
+  // around C's axis w = (-1.49e-8, 0, -1) (|w| = 1 + 1.1e-16), sampled at u = 0. w is 2e-24 rad off p (with
+  // rounding, |w x p| < 1e-23), and g stretches by (1 + r) / (1 - r) = 1.8e16 at p: g(w) lies within 1e-6 rad of -p.
   const Vec3<double> rp(-1.4901161193847653e-08, -0.0, -0.99999999999999978), w(-1.4901161193847656e-08, 0.0, -1.0);
   const Vec3<double> p = rp / rp.norm();
   const Vec3<double> g = pivot_transform(w, rp);
@@ -385,12 +384,11 @@ TEST(SptdCaps, ClosedFormCapIntegralsEq10MatchQuadratureOfEq8) {
 // in double where it is small: caps of 1e-2 .. 1e-4 rad straddling the cosine's horizon, against the kernel in
 // long double on the same (exactly widened) cap. R's area moves by at most its height 2 sin(alpha) per unit of
 // abscissa and the abscissae x_c, x0 carry a few eps absolute: tolerance 8 eps 2 sin(alpha) / area + 16 eps.
-// Before the segment form (CosineCapView::seg0) the disk part was a difference of two areas ~pi, off by ~eps pi
-// absolute: measured 1.0e-6 relative at alpha = 1.4e-3 (tolerance 1.4e-8), 2.1e-4 at 1e-4 (found by
-// fuzz_sptd_double, 74048ece...). And caps whose axis lies on the horizon up to rounding (cos t = 1e-300 and
-// cos(pi/2) in double): R is the disk right of x0 = cos(alpha), area alpha - sin(alpha) cos(alpha); the test
-// x0 >= x_c + A for R = E held there up to rounding and gave the area of the degenerate ellipse, 5e-301 and
-// 3e-17 (fuzz_sptd_double, 71c188cc...).
+// The segment form (CosineCapView::seg0) keeps the disk part from being a difference of two areas ~pi, off by
+// ~eps pi absolute: 1.0e-6 relative at alpha = 1.4e-3 (tolerance 1.4e-8), 2.1e-4 at 1e-4. And caps whose axis lies
+// on the horizon up to rounding (cos t = 1e-300 and cos(pi/2) in double): R is the disk right of x0 = cos(alpha),
+// area alpha - sin(alpha) cos(alpha); the test x0 >= x_c + A for R = E holds there up to rounding and must not
+// give the area of the degenerate ellipse, 5e-301 and 3e-17.
 TEST(SptdCaps, CosineCapAreaIsAccurateInDoubleForSmallCapsAcrossAndOnTheHorizon) {
   const double e = std::numeric_limits<double>::epsilon();
   for (double alpha : {1e-2, 1.4e-3, 1e-4})
@@ -414,11 +412,10 @@ TEST(SptdCaps, CosineCapAreaIsAccurateInDoubleForSmallCapsAcrossAndOnTheHorizon)
 }
 
 // A crescent whose tip is within rounding of the unit circle's leftmost point (1 + x0 = 1.1e-16: g(C)'s boundary
-// tangent to the horizon at E's vertex). c0 = sqrt(1 - x0^2) and E's half-height there were computed independently,
-// each the square root of a difference within rounding of 0 (1.49e-8 against 1.38e-8), and the crescent's terms
-// did not cancel: the integral 4.7e-11 off relatively (fuzz_sptd_double 4d8f70f9, issue 7). Now within a few eps
-// of long double's; the image g(C) itself carries a few eps of the pivot transform, to which an area of ~3 is
-// not sensitive beyond O(1): 64 eps.
+// tangent to the horizon at E's vertex). Computed independently, c0 = sqrt(1 - x0^2) and E's half-height there are
+// each the square root of a difference within rounding of 0 (1.49e-8 against 1.38e-8), the crescent's terms do not
+// cancel, and the integral is 4.7e-11 off relatively. The kernel's is within a few eps of long double's; the image
+// g(C) itself carries a few eps of the pivot transform, to which an area of ~3 is not sensitive beyond O(1): 64 eps.
 TEST(SptdCaps, ClampedCosineIntegralIsAccurateWhenTheCrescentTipTouchesTheHorizonAtEsVertex) {
   SptdCapGeometry<double> g;
   g.sptd.pivot = Vec3<double>(0, 0.5, 0);
@@ -434,14 +431,14 @@ TEST(SptdCaps, ClampedCosineIntegralIsAccurateWhenTheCrescentTipTouchesTheHorizo
 }
 
 // The same crescent's tip near E's top instead (x0 - x_c within rounding of 0: g(C) a near-hemisphere, 1 - cos =
-// 1 - d). Taking n0 = c0 / sin(alpha) there made tau0 = sqrt(1 - n0^2) the square root of a difference within
-// rounding of 0 (fuzz_sptd_double bd9360f1, 9219e2fc: the area 2.1e-8 resp. 4.1e-10 off relatively, issue 7).
+// 1 - d). Taking n0 = c0 / sin(alpha) there makes tau0 = sqrt(1 - n0^2) the square root of a difference within
+// rounding of 0 (areas 2.1e-8 and 4.1e-10 off relatively).
 // Reference: the projected solid angle of a hemisphere at angle t from n is (pi / 2)(1 + cos t) (Lambert's formula
 // for the lune), and dP/dalpha = sin(alpha) times the cosine integral over the boundary circle = 2 sin t there, so
 // P = (pi / 2)(1 + cos t) - 2 sin t asin(d) + O(d^2) (cos alpha = d; O(d^2) < 1e-19 for d <= 1e-10). Tolerance as
 // in CosineCapAreaIsAccurateInDoubleForSmallCapsAcrossAndOnTheHorizon: the abscissae carry a few eps, R's area
-// moves by its height 2 sin(alpha) per unit of abscissa. Measured: within 18 eps (t = 2.9, d = 8.2e-14); on
-// ce4c71c up to 2.9e9 eps.
+// moves by its height 2 sin(alpha) per unit of abscissa. Measured: within 18 eps (t = 2.9, d = 8.2e-14); with
+// n0 = c0 / sin(alpha), up to 2.9e9 eps.
 TEST(SptdCaps, ClampedCosineIntegralIsAccurateWhenTheCrescentTipIsNearEsTop) {
   const double e = std::numeric_limits<double>::epsilon();
   for (double t : {2.1331, 1.6162, 2.9})
@@ -582,9 +579,8 @@ TEST(SptdSampling, SamplesLieInTheCapWithTheRestrictedNormalisedEq8Density) {
 // A pivot near the sphere shrinks a cap on its far side into an image next to r_p's direction (registry case
 // pivot-0.999-away: |r_p| = 0.999, image radius 5.8e-4 rad). Unit vectors there are rounded by float's eps, which
 // g stretches by k / |w - r_p|^2 ~ 1700 on the way back; samples and densities formed from offsets to r_p
-// (pivot_transform_cap's axis_minus_pivot) do not see that. Measured by this test: worst 4.1e-7 rad; with unit
-// vectors in the image (the kernel before that change, compiled against this test's loop) 1.8e-4, and 9 of the 1e5
-// float samples declined.
+// (pivot_transform_cap's axis_minus_pivot) do not see that. Measured by this test: worst 4.1e-7 rad; formed from
+// unit vectors in the image instead, 1.8e-4, and 9 of the 1e5 float samples declined.
 TEST(SptdSampling, FloatSamplesOfAUniformSptdWithItsPivotAt0999FarFromTheCapMatchLongDoubleToAFewUlps) {
   const Vec3L diag = Vec3L(0.3L, -0.5L, 0.8L).normalized();
   SptdCapGeometry<L> g;
@@ -612,10 +608,10 @@ TEST(SptdSampling, FloatSamplesOfAUniformSptdWithItsPivotAt0999FarFromTheCapMatc
 // float near its tip x0 (u0 -> 0) and near the disk's rim (u0 -> 1), against the long double sampler on the same
 // (float) geometry, exactly widened. Near x0 the crescent's mass grows like (x - x0)^3 while the difference form
 // disk(x0..x) - (E(x) - E(x0)) subtracts two terms ~2 c0 (x - x0), and near x = 1 the area right of x is a rounded
-// x's 1 - x; both left float's x(u) wrong by far more than its rounding. Measured by this test: worst 3.1e-7 rad
+// x's 1 - x; both leave float's x(u) wrong by far more than its rounding. Measured by this test: worst 3.1e-7 rad
 // near the tip and 1.8e-7 near the rim, none declined; the difference form with x solved to x's relative
-// precision (the kernel before issue 5's crescent change): 5.7e-3 and 6.2e-4 rad, and 1699 of the 14700 samples
-// declined (x = x0 exactly, z = 0). (1 - d rounds to 1 in float for d < 6e-8: those u0 are left out.)
+// precision: 5.7e-3 and 6.2e-4 rad, and 1699 of the 14700 samples declined (x = x0 exactly, z = 0). (1 - d rounds
+// to 1 in float for d < 6e-8: those u0 are left out.)
 TEST(SptdSampling, FloatCosineCapCrescentSamplesMatchLongDoubleToAFewUlpsNearTheTipAndTheRim) {
   SptdCapGeometry<L> g;
   g.sptd.pivot = Vec3L(0.2L, 0, 0.3L);

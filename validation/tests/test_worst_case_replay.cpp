@@ -66,7 +66,7 @@ TEST(RecordedWorstCases, AreNoWorseWithTheCurrentKernels) {
     }
     EXPECT_FALSE(std::isnan(now)) << "the recorded input is no longer a valid point of " << r.search;
     // Slack of one part in 1e9: a kernel edit that only changes rounding moves a recorded error by ~1e-12
-    // relative (measured after the issue-7 fixes to polygon_projected.h), which is not a regression; a worst
+    // relative (measured across rounding-only edits of polygon_projected.h), which is not a regression; a worst
     // case that gets worse by more than that is.
     EXPECT_LE(now, r.best_f * (1 + kReplaySlack))
         << r.search << ": recorded " << r.best_f << " (" << r.kernel_version << "), now " << now;

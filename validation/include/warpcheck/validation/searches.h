@@ -1,4 +1,4 @@
-// warpcheck/validation/searches.h: worst-case error searches (issue 6).
+// warpcheck/validation/searches.h: worst-case error searches.
 //
 // A Search is an error measure maximised by the multi-start Nelder-Mead of nelder_mead.h over a documented box
 // of parameters (every parameter has a name, bounds and a meaning; `warpcheck worst-case --list` prints them).
@@ -41,7 +41,7 @@ struct Search {
   // True where the objective calls a point "unresolved" (NaN) by comparing finite differences of the long
   // double warp with steps h and 2h. Whether a point next to a kink passes that test depends on the last bits
   // of the x87 transcendental instructions behind long double atan2/exp/log, which differ between CPUs: the
-  // same kernel (e3a42d4) and the same recorded input gave 2.0e-9 on one of our machines and NaN on another.
+  // same kernel and the same recorded input can give 2.0e-9 on one CPU and NaN on another.
   // The replay (test_worst_case_replay.cpp) therefore reports such a record's NaN instead of failing on it.
   bool resolution_depends_on_cpu = false;
 
@@ -110,7 +110,7 @@ void run_search(const Search& s, SearchRecord& state, const RunOptions& o);
 // different searches.
 SearchRecord merge_records(const std::vector<SearchRecord>& records);
 
-// Search families defined in other files of validation/src (called by all_searches()).
+// Search families defined in other files of validation/searches (called by all_searches()).
 void append_polygon_searches(std::vector<Search>& v);  // polygon.cpp: Peters 2021 backward errors
 void append_kernel_searches(std::vector<Search>& v);   // kernels.cpp: precision and pdf vs warp
 void append_cap_searches(std::vector<Search>& v);      // caps.cpp: projected caps, SPTD caps
