@@ -77,14 +77,24 @@ std::string joined(const char* head, const std::vector<std::string>& args) {
   return c;
 }
 
-}  // namespace
-
-int worst_case_main(const std::vector<std::string>& args) {
+// The command line of `warpcheck worst-case`.
+struct WorstCaseOptions {
   std::string name, checkpoint, json, evaluate;
   double seconds = 60, checkpoint_every = 10, progress = 5;
   int threads = 1;
   std::uint64_t seed = 1, shard_index = 0, shard_count = 1;
-  bool list = false;
+  bool list = false, help = false;
+};
+
+void parse_shard(const std::string& v, WorstCaseOptions& o) {
+  const auto slash = v.find('/');
+  if (slash == std::string::npos) throw UsageError("--shard needs I/N, e.g. 3/8, got '" + v + "'");
+  o.shard_count = parse_u64("--shard N", v.substr(slash + 1), 1, UINT32_MAX);
+  o.shard_index = parse_u64("--shard I", v.substr(0, slash), 0, o.shard_count - 1);
+}
+
+WorstCaseOptions parse_worst_case(const std::vector<std::string>& args) {
+  WorstCaseOptions o;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     auto value = [&]() -> const std::string& {
@@ -92,131 +102,152 @@ int worst_case_main(const std::vector<std::string>& args) {
       return args[++i];
     };
     if (a == "--help" || a == "-h") {
-      std::fputs(kWorstCaseHelp, stdout);
-      return 0;
+      o.help = true;
+      return o;
     } else if (a == "--list")
-      list = true;
+      o.list = true;
     else if (a == "--search")
-      name = value();
+      o.name = value();
     else if (a == "--seconds")
-      seconds = parse_double(a, value(), 0, 1e9);
+      o.seconds = parse_double(a, value(), 0, 1e9);
     else if (a == "--threads")
-      threads = int(parse_u64(a, value(), 1, 1024));
+      o.threads = int(parse_u64(a, value(), 1, 1024));
     else if (a == "--seed")
-      seed = parse_u64(a, value(), 0, UINT64_MAX);
+      o.seed = parse_u64(a, value(), 0, UINT64_MAX);
     else if (a == "--checkpoint")
-      checkpoint = value();
+      o.checkpoint = value();
     else if (a == "--checkpoint-every")
-      checkpoint_every = parse_double(a, value(), 0.1, 1e9);
+      o.checkpoint_every = parse_double(a, value(), 0.1, 1e9);
     else if (a == "--progress")
-      progress = parse_double(a, value(), 0, 1e9);
+      o.progress = parse_double(a, value(), 0, 1e9);
     else if (a == "--json")
-      json = value();
+      o.json = value();
     else if (a == "--evaluate")
-      evaluate = value();
-    else if (a == "--shard") {
-      const std::string v = value();
-      const auto slash = v.find('/');
-      if (slash == std::string::npos) throw UsageError("--shard needs I/N, e.g. 3/8, got '" + v + "'");
-      shard_count = parse_u64("--shard N", v.substr(slash + 1), 1, UINT32_MAX);
-      shard_index = parse_u64("--shard I", v.substr(0, slash), 0, shard_count - 1);
-    } else
+      o.evaluate = value();
+    else if (a == "--shard")
+      parse_shard(value(), o);
+    else
       throw UsageError("unknown option '" + a + "'");
   }
-  if (list) {
-    list_searches();
-    return 0;
-  }
-  if (name.empty()) throw UsageError("--search NAME is required (see --list)");
-  const std::optional<Search> search = find_search(name);
-  if (!search) throw UsageError("unknown search '" + name + "' (see --list)");
-  if (!evaluate.empty()) {
-    SearchRecord r;
-    try {
-      r = record_from_json(read_file(evaluate));
-    } catch (const std::exception& e) {
-      std::fprintf(stderr, "warpcheck worst-case: %s: %s\n", evaluate.c_str(), e.what());
-      return 1;
-    }
-    const std::optional<Search> from = find_search(r.search);
-    bool same = from && from->parameters.size() == search->parameters.size();
-    for (std::size_t i = 0; same && i < search->parameters.size(); ++i)
-      same = from->parameters[i].name == search->parameters[i].name;
-    if (!same)
-      throw UsageError(evaluate + " holds an input of '" + r.search + "', whose parameters differ from '" + name +
-                       "'s");
-    if (r.best_x.empty()) throw UsageError(evaluate + " holds no input");
-    const long double value = search->objective(r.best_x);
-    std::printf("%s at the input of %s: %.6Le\n", name.c_str(), evaluate.c_str(), value);
-    if (!json.empty()) {
-      r.search = name;
-      r.best_f = value;
-      if (!r.history.empty()) r.history.back().best_f = value;
-      r.kernel_version = source_version();
-      r.command = joined("warpcheck worst-case", args);
-      write_file_atomically(json, to_json(r, &*search));
-    }
-    return 0;
-  }
+  return o;
+}
 
+// --evaluate FILE: the search's objective at the input a record holds (of this search or one with the same
+// parameters), printed and, with --json, written as a record of this search.
+int evaluate_record(const Search& search, const WorstCaseOptions& o, const std::vector<std::string>& args) {
+  SearchRecord r;
+  try {
+    r = record_from_json(read_file(o.evaluate));
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "warpcheck worst-case: %s: %s\n", o.evaluate.c_str(), e.what());
+    return 1;
+  }
+  const std::optional<Search> from = find_search(r.search);
+  bool same = from && from->parameters.size() == search.parameters.size();
+  for (std::size_t i = 0; same && i < search.parameters.size(); ++i)
+    same = from->parameters[i].name == search.parameters[i].name;
+  if (!same)
+    throw UsageError(o.evaluate + " holds an input of '" + r.search + "', whose parameters differ from '" + o.name +
+                     "'s");
+  if (r.best_x.empty()) throw UsageError(o.evaluate + " holds no input");
+  const long double value = search.objective(r.best_x);
+  std::printf("%s at the input of %s: %.6Le\n", o.name.c_str(), o.evaluate.c_str(), value);
+  if (!o.json.empty()) {
+    r.search = o.name;
+    r.best_f = value;
+    if (!r.history.empty()) r.history.back().best_f = value;
+    r.kernel_version = source_version();
+    r.command = joined("warpcheck worst-case", args);
+    write_file_atomically(o.json, to_json(r, &search));
+  }
+  return 0;
+}
+
+// The record a run starts from: its checkpoint when one exists (it must be of the same search, seed and shard),
+// else an empty record. Empty optional: the checkpoint could not be read (reported).
+std::optional<SearchRecord> starting_record(const WorstCaseOptions& o) {
   SearchRecord state;
-  state.search = name, state.seed = seed, state.shard_index = shard_index, state.shard_count = shard_count;
-  if (!checkpoint.empty() && file_exists(checkpoint)) {
-    try {
-      state = record_from_json(read_file(checkpoint));
-    } catch (const std::exception& e) {
-      std::fprintf(stderr, "warpcheck worst-case: checkpoint %s: %s\n", checkpoint.c_str(), e.what());
-      return 1;
-    }
-    if (state.search != name || state.seed != seed || state.shard_index != shard_index ||
-        state.shard_count != shard_count)
-      throw UsageError("checkpoint " + checkpoint + " belongs to search '" + state.search + "' seed " +
-                       std::to_string(state.seed) + " shard " + std::to_string(state.shard_index) + "/" +
-                       std::to_string(state.shard_count) + ", not to this command");
-    std::fprintf(stderr, "resuming from %s: %.1f s, %llu chains, best %.3Le\n", checkpoint.c_str(), state.seconds,
-                 (unsigned long long)state.chains, state.best_f);
+  state.search = o.name, state.seed = o.seed, state.shard_index = o.shard_index, state.shard_count = o.shard_count;
+  if (o.checkpoint.empty() || !file_exists(o.checkpoint)) return state;
+  try {
+    state = record_from_json(read_file(o.checkpoint));
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "warpcheck worst-case: checkpoint %s: %s\n", o.checkpoint.c_str(), e.what());
+    return std::nullopt;
   }
-  state.kernel_version = source_version();
-  state.command = joined("warpcheck worst-case", args);
-  state.target_seconds = seconds;
+  if (state.search != o.name || state.seed != o.seed || state.shard_index != o.shard_index ||
+      state.shard_count != o.shard_count)
+    throw UsageError("checkpoint " + o.checkpoint + " belongs to search '" + state.search + "' seed " +
+                     std::to_string(state.seed) + " shard " + std::to_string(state.shard_index) + "/" +
+                     std::to_string(state.shard_count) + ", not to this command");
+  std::fprintf(stderr, "resuming from %s: %.1f s, %llu chains, best %.3Le\n", o.checkpoint.c_str(), state.seconds,
+               (unsigned long long)state.chains, state.best_f);
+  return state;
+}
 
+// The search's run: a checkpoint periodically and at the next tick (0.25 s) after every improvement of the best
+// so far, progress on stderr, the record to --json (or stdout) at the end.
+int run_worst_case(const Search& search, const WorstCaseOptions& w, SearchRecord& state) {
   std::signal(SIGINT, on_stop_signal);
   std::signal(SIGTERM, on_stop_signal);
   RunOptions o;
-  o.seconds = seconds;
-  o.threads = threads;
+  o.seconds = w.seconds;
+  o.threads = w.threads;
   o.stop = &g_stop;
   o.tick_seconds = 0.25;
   double last_checkpoint = state.seconds, last_progress = state.seconds;
   std::size_t checkpointed_improvements = state.history.size();
   o.tick = [&](const SearchRecord& snap, double rate) {
-    // Periodically, and at the next tick (0.25 s) after every improvement of the best-so-far.
-    if (!checkpoint.empty() &&
-        (snap.seconds - last_checkpoint >= checkpoint_every || snap.history.size() != checkpointed_improvements)) {
-      write_file_atomically(checkpoint, to_json(snap, &*search));
+    if (!w.checkpoint.empty() &&
+        (snap.seconds - last_checkpoint >= w.checkpoint_every || snap.history.size() != checkpointed_improvements)) {
+      write_file_atomically(w.checkpoint, to_json(snap, &search));
       last_checkpoint = snap.seconds;
       checkpointed_improvements = snap.history.size();
     }
-    if (progress > 0 && snap.seconds - last_progress >= progress) {
-      std::fprintf(stderr, "[%s %llu/%llu] %.0f/%.0f s  chains %llu  evals %lld (%.3g/s)  best %.4Le\n", name.c_str(),
-                   (unsigned long long)snap.shard_index, (unsigned long long)snap.shard_count, snap.seconds, seconds,
+    if (w.progress > 0 && snap.seconds - last_progress >= w.progress) {
+      std::fprintf(stderr, "[%s %llu/%llu] %.0f/%.0f s  chains %llu  evals %lld (%.3g/s)  best %.4Le\n", w.name.c_str(),
+                   (unsigned long long)snap.shard_index, (unsigned long long)snap.shard_count, snap.seconds, w.seconds,
                    (unsigned long long)snap.chains, snap.evaluations, rate, snap.best_f);
       last_progress = snap.seconds;
     }
   };
   try {
-    run_search(*search, state, o);
-    const std::string text = to_json(state, &*search);
-    if (!checkpoint.empty()) write_file_atomically(checkpoint, text);
-    if (json.empty())
+    run_search(search, state, o);
+    const std::string text = to_json(state, &search);
+    if (!w.checkpoint.empty()) write_file_atomically(w.checkpoint, text);
+    if (w.json.empty())
       std::fputs(text.c_str(), stdout);
     else
-      write_file_atomically(json, text);
+      write_file_atomically(w.json, text);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "warpcheck worst-case: %s\n", e.what());
     return 1;
   }
   return 0;
+}
+
+}  // namespace
+
+int worst_case_main(const std::vector<std::string>& args) {
+  const WorstCaseOptions o = parse_worst_case(args);
+  if (o.help) {
+    std::fputs(kWorstCaseHelp, stdout);
+    return 0;
+  }
+  if (o.list) {
+    list_searches();
+    return 0;
+  }
+  if (o.name.empty()) throw UsageError("--search NAME is required (see --list)");
+  const std::optional<Search> search = find_search(o.name);
+  if (!search) throw UsageError("unknown search '" + o.name + "' (see --list)");
+  if (!o.evaluate.empty()) return evaluate_record(*search, o, args);
+  std::optional<SearchRecord> state = starting_record(o);
+  if (!state) return 1;
+  state->kernel_version = source_version();
+  state->command = joined("warpcheck worst-case", args);
+  state->target_seconds = o.seconds;
+  return run_worst_case(*search, o, *state);
 }
 
 int merge_main(const std::vector<std::string>& args) {

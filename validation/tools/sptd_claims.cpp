@@ -82,29 +82,8 @@ Vec3<L> random_unit(std::mt19937_64& r) {
   }
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  long pairs = 1'000'000;
-  unsigned long seed = 1;
-  std::string out = std::string(WARPCHECK_SOURCE_DIR) + "/data/sptd/claims.json";
-  std::string command = "sptd_claims";
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (i + 1 >= argc || (a != "--pairs" && a != "--seed" && a != "--out")) {
-      std::fprintf(stderr, "usage: sptd_claims [--pairs N] [--seed S] [--out FILE]\n");
-      return 2;
-    }
-    const std::string v = argv[++i];
-    if (a == "--pairs") pairs = std::atol(v.c_str());
-    if (a == "--seed") seed = std::strtoul(v.c_str(), nullptr, 10);
-    if (a == "--out")
-      out = v;
-    else
-      command += " " + a + " " + v;
-  }
-
-  // ---- 1. HG fit ----
+// Section 1: the pivot phase function fitted to Henyey-Greenstein (Eqs. 25-28), L1 distance on a grid of g.
+std::string hg_fit_section() {
   std::string hg_rows;
   double worst_fit = 0, worst_fit_g = 0, worst_opt = 0, worst_mass = 0;
   std::vector<L> grid;
@@ -127,9 +106,24 @@ int main(int argc, char** argv) {
         double(g), double(gp), double(d), double(mean_cosine(gp)), double(best.first), double(best.second));
     hg_rows += (hg_rows.empty() ? "" : ",\n") + std::string(b);
   }
+  std::string j = "  \"hg_fit\": {\n";
+  j += "    \"what\": \"pivot phase function (Eq. 25) with g_p from Eqs. 27-28 vs Henyey-Greenstein (Eq. 26): L1 "
+       "distance over the sphere (0 identical, 2 disjoint)\",\n";
+  j += "    \"paper\": \"no number: the fit gives 'very similar renderings' (Sec. 6.2; Fig. 15 polar plots, Fig. 16 "
+       "renderings, Fig. 18 at g = 0.9)\",\n";
+  char b[400];
+  std::snprintf(b, sizeof b,
+                "    \"max_l1\": %.4e, \"at_g\": %.2f, \"max_l1_with_optimal_g_p\": %.4e, "
+                "\"max_normalisation_error_eq9\": %.3e,\n",
+                worst_fit, worst_fit_g, worst_opt, worst_mass);
+  j += b;
+  j += "    \"rows\": [\n" + hg_rows + "\n    ]\n  },\n";
+  return j;
+}
 
-  // ---- 2. Eq. 37 ----
-  // Two regimes: half-angles uniform in (0, pi), and in (0, pi / 6) (sphere lights and bent cones).
+// Section 2: Eq. 37's approximate two-cap intersection against Eqs. 35-36 on random partially overlapping pairs, in
+// two regimes: half-angles uniform in (0, pi), and in (0, pi / 6) (sphere lights and bent cones).
+std::string two_cap_section(long pairs, unsigned long seed) {
   std::mt19937_64 r(seed);
   std::uniform_real_distribution<double> u(0, 1);
   std::vector<double> abs_err[2], rel_err[2];
@@ -151,23 +145,7 @@ int main(int argc, char** argv) {
       rel_err[regime].push_back(double(std::abs(approx - exact) / scale));
     }
   }
-
-  std::string j = "{\n";
-  j += "  \"command\": \"" + command + "\",\n";
-  j += "  \"seed\": " + std::to_string(seed) + ",\n";
-  j += "  \"hg_fit\": {\n";
-  j += "    \"what\": \"pivot phase function (Eq. 25) with g_p from Eqs. 27-28 vs Henyey-Greenstein (Eq. 26): L1 "
-       "distance over the sphere (0 identical, 2 disjoint)\",\n";
-  j += "    \"paper\": \"no number: the fit gives 'very similar renderings' (Sec. 6.2; Fig. 15 polar plots, Fig. 16 "
-       "renderings, Fig. 18 at g = 0.9)\",\n";
-  char b[400];
-  std::snprintf(b, sizeof b,
-                "    \"max_l1\": %.4e, \"at_g\": %.2f, \"max_l1_with_optimal_g_p\": %.4e, "
-                "\"max_normalisation_error_eq9\": %.3e,\n",
-                worst_fit, worst_fit_g, worst_opt, worst_mass);
-  j += b;
-  j += "    \"rows\": [\n" + hg_rows + "\n    ]\n  },\n";
-  j += "  \"two_cap_eq37\": {\n";
+  std::string j = "  \"two_cap_eq37\": {\n";
   j += "    \"what\": \"|Eq. 37 - Eqs. 35-36| on random partially overlapping cap pairs (axes uniform on the sphere, "
        "half-angles uniform in each regime)\",\n";
   j += "    \"paper\": \"no number: Eq. 37 (Oat and Sander 2007) is 'an approximation of Equation (36)' used in the "
@@ -179,7 +157,36 @@ int main(int argc, char** argv) {
   j += "    \"half_angles_up_to_30_deg\": {\"partial_overlap\": " + std::to_string(abs_err[1].size()) +
        ", \"abs_error_sr\": " + json(stats(abs_err[1])) +
        ", \"error_relative_to_smaller_cap\": " + json(stats(rel_err[1])) + "}\n";
-  j += "  }\n}\n";
+  j += "  }\n";
+  return j;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  long pairs = 1'000'000;
+  unsigned long seed = 1;
+  std::string out = std::string(WARPCHECK_SOURCE_DIR) + "/data/sptd/claims.json";
+  std::string command = "sptd_claims";
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (i + 1 >= argc || (a != "--pairs" && a != "--seed" && a != "--out")) {
+      std::fprintf(stderr, "usage: sptd_claims [--pairs N] [--seed S] [--out FILE]\n");
+      return 2;
+    }
+    const std::string v = argv[++i];
+    if (a == "--pairs") pairs = std::atol(v.c_str());
+    if (a == "--seed") seed = std::strtoul(v.c_str(), nullptr, 10);
+    if (a == "--out")
+      out = v;
+    else
+      command += " " + a + " " + v;
+  }
+  const std::string hg = hg_fit_section();
+  std::string j = "{\n";
+  j += "  \"command\": \"" + command + "\",\n";
+  j += "  \"seed\": " + std::to_string(seed) + ",\n";
+  j += hg + two_cap_section(pairs, seed) + "}\n";
   std::fputs(j.c_str(), stdout);
   const std::filesystem::path parent = std::filesystem::path(out).parent_path();
   if (!parent.empty()) std::filesystem::create_directories(parent);
