@@ -22,6 +22,7 @@
 #include <concepts>
 #include <functional>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -74,10 +75,26 @@ struct SamplerUnderTest {
   // crosses one, so that parts of the support thinner than its nodes' spacing (an acute corner's tip) keep
   // their mass. Without them a polygon seen 0.3 deg from its plane lost 0.25% of its mass.
   std::vector<Vec3L> boundary_planes;
+  // Optional block forms of sample and pdf, for speed: out[i] = sample(u0[i], u1[i]) and out[i] = pdf(w[i]), bit
+  // for bit, with the per-light work and the call paid once per block. bind_kernel fills both; sample_many and
+  // pdf_many below fall back to the single forms.
+  std::function<void(std::span<const double> u0, std::span<const double> u1, std::span<Sample> out)> sample_block;
+  std::function<void(std::span<const Vec3L> w, std::span<Real> out)> pdf_block;
   // Geometry for which the sampler must decline every sample (e.g. a light entirely below the horizon):
   // the battery then checks only that every sample is declined and the pdf is zero everywhere.
   bool expect_no_sample = false;
 };
+
+// The sampler's samples (pdfs) of a block of primary samples (directions), through the block form when it has one.
+inline void sample_many(const SamplerUnderTest& s, std::span<const double> u0, std::span<const double> u1,
+                        std::span<Sample> out) {
+  if (s.sample_block) return s.sample_block(u0, u1, out);
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = s.sample(u0[i], u1[i]);
+}
+inline void pdf_many(const SamplerUnderTest& s, std::span<const Vec3L> w, std::span<Real> out) {
+  if (s.pdf_block) return s.pdf_block(w, out);
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = s.pdf(w[i]);
+}
 
 // ---- Kernel concept: for samplers written as warpcheck-style kernels ---------------------------------------
 
@@ -137,6 +154,13 @@ template <Kernel K> SamplerUnderTest bind_kernel(std::string config, const typen
     return to_sample(K::sample(v, Vec2<T>(to_unit<T>(u0), to_unit<T>(u1))));
   };
   s.pdf = [v = K::view(g)](const Vec3L& w) { return Real(K::pdf(v, w.template cast<T>())); };
+  s.sample_block = [v = K::view(g)](std::span<const double> u0, std::span<const double> u1, std::span<Sample> out) {
+    for (std::size_t i = 0; i < out.size(); ++i)
+      out[i] = to_sample(K::sample(v, Vec2<T>(to_unit<T>(u0[i]), to_unit<T>(u1[i]))));
+  };
+  s.pdf_block = [v = K::view(g)](std::span<const Vec3L> w, std::span<Real> out) {
+    for (std::size_t i = 0; i < out.size(); ++i) out[i] = Real(K::pdf(v, w[i].template cast<T>()));
+  };
   const Cap<T> cap = K::bounding_cap(g);
   s.bounding_cap = Cap<Real>{to_long(cap.axis).normalized(), Real(cap.one_minus_cos)};
   s.kinks_u0 = kernel_kinks<K>(g, 0);
