@@ -168,6 +168,14 @@ template <class T> struct PolygonLtc {
     return bounding_cap_of_directions(w.data(), n);
   }
   static T normaliser(const View& v) { return v.transformed.projected_solid_angle; }  // of M^-1 P (Eq. 10)
+  // P's edges and the image of the horizon under M (a plane through the origin maps to one, normal M^-T z).
+  static std::vector<Vec3<T>> boundary_planes(const Geometry& g) {
+    std::vector<Vec3<T>> planes = polygon_edge_planes(g.polygon);
+    const View v = view(g);
+    const Vec3<T> horizon = v.frame.to_world(Vec3<T>(v.m_inv.transpose() * Vec3<T>(T(0), T(0), T(1))));
+    if (horizon.norm() > T(0)) planes.push_back(horizon.normalized());
+    return planes;
+  }
   // The sectors of M^-1 P picked by u0 (polygon_projected.h): M is smooth, so the LTC warp has their kinks.
   static std::vector<T> kinks_u0(const Geometry& g) {
     const View v = view(g);

@@ -656,6 +656,8 @@ template <class T, CutDiskInverse M> struct SphereProjectedCapKernel {
     const View v = make_projected_cap_view(g);
     return v.valid() ? projected_cap_bounding_cap(v) : make_sphere_view(g).cap();
   }
+  // The horizon, where the cut cap ends and the density's cosine reaches 0.
+  static std::vector<Vec3<T>> boundary_planes(const Geometry& g) { return {g.shading.normal.normalized()}; }
   // A_E + A_D: the projected solid angle in Cases 1-2 (Case 3's density is not uniform in the disk).
   static T normaliser(const View& v) { return v.total; }
   // Case 2's threshold tau (the warp passes from the ellipse to the disk: continuous, its derivative jumps) and,

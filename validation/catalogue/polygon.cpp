@@ -12,21 +12,6 @@
 namespace warpcheck::validation {
 namespace {
 
-// The angular width of the polygon seen from x: for a convex spherical polygon, the smallest over its edges of
-// the largest angular distance of a vertex from the edge's great circle (a polygon seen 0.3 deg from its plane:
-// 2.7e-3 rad, in a bounding cap of 0.32 rad).
-Real angular_width(const PolygonLightGeometry<Real>& g, const std::vector<Vec3L>& edges) {
-  Real width = kPi<Real>;
-  for (const Vec3L& m : edges) {
-    Real far = 0;
-    for (int j = 0; j < g.light.count; ++j)
-      far = std::max(
-          far, std::asin(std::min<Real>(1, std::abs(m.dot((g.light.vertices[j] - g.shading.position).normalized())))));
-    width = std::min(width, far);
-  }
-  return width;
-}
-
 // What each kernel's normaliser measures (its independent reference: polygon.h's long double references, the
 // shoelace area).
 enum class Measure { kProjected, kSolid, kSolidClipped, kArea };
@@ -203,11 +188,6 @@ Real float_tolerance(const G& g) {
 template <template <class> class K, class T> SamplerUnderTest make_sampler(const PolygonConfig& c) {
   SamplerUnderTest s = bind_kernel<K<T>, K<Real>>(c.name, c.g.template cast<T>(), c.g);
   s.expect_no_sample = !K<Real>::sample(K<Real>::view(c.g), Vec2<Real>(0.5L, 0.5L)).valid();
-  // Breakpoints only for slivers (thinner than a sixteenth of the bounding cap's radius, the default grid's
-  // ring spacing): they multiply the quadrature's cost (about 4x on central-square), and the default nodes
-  // resolve every other configuration.
-  const Real theta_max = std::acos(std::clamp<Real>(1 - s.bounding_cap.one_minus_cos, -1, 1));
-  if (angular_width(c.g, polygon_edge_planes(c.g)) < theta_max / 16) s.boundary_planes = K<Real>::boundary_planes(c.g);
   if (s.expect_no_sample) return s;
   Normalization n = reference_normalization(measure_of(K<T>::name)->measure, c.g);
   n.kernel = [g = c.g.template cast<T>()] { return Real(K<T>::normaliser(K<T>::view(g))); };

@@ -142,8 +142,16 @@ template <class T> Sample to_sample(const DirectionSample<T>& s) {
   return Sample{to_long(s.direction), Real(s.pdf), s.valid()};
 }
 
+// A kernel's boundary planes (catalogue.h), empty if it declares none.
+template <Kernel K> std::vector<Vec3L> kernel_boundary_planes(const typename K::Geometry& g) {
+  std::vector<Vec3L> planes;
+  if constexpr (requires { K::boundary_planes(g); })
+    for (const auto& m : K::boundary_planes(g)) planes.push_back(to_long(m));
+  return planes;
+}
+
 // Binds kernel K to geometry g (in K's scalar type; the caller converts it): sample and pdf on one view of g,
-// K's bounding cap and kinks.
+// K's bounding cap, kinks and boundary planes.
 template <Kernel K> SamplerUnderTest bind_kernel(std::string config, const typename K::Geometry& g) {
   using T = typename K::Scalar;
   SamplerUnderTest s;
@@ -165,11 +173,12 @@ template <Kernel K> SamplerUnderTest bind_kernel(std::string config, const typen
   s.bounding_cap = Cap<Real>{to_long(cap.axis).normalized(), Real(cap.one_minus_cos)};
   s.kinks_u0 = kernel_kinks<K>(g, 0);
   s.kinks_u1 = kernel_kinks<K>(g, 1);
+  s.boundary_planes = kernel_boundary_planes<K>(g);
   return s;
 }
 
 // As above, with KRef (the same kernel in long double, on the same geometry converted) as the reference warp;
-// the bounding cap and the kinks come from KRef.
+// the bounding cap, the kinks and the boundary planes come from KRef.
 template <Kernel K, Kernel KRef>
 SamplerUnderTest bind_kernel(std::string config, const typename K::Geometry& g, const typename KRef::Geometry& g_ref) {
   SamplerUnderTest s = bind_kernel<K>(std::move(config), g);
@@ -182,6 +191,7 @@ SamplerUnderTest bind_kernel(std::string config, const typename K::Geometry& g, 
   s.bounding_cap = Cap<Real>{to_long(cap.axis).normalized(), Real(cap.one_minus_cos)};
   s.kinks_u0 = kernel_kinks<KRef>(g_ref, 0);
   s.kinks_u1 = kernel_kinks<KRef>(g_ref, 1);
+  s.boundary_planes = kernel_boundary_planes<KRef>(g_ref);
   return s;
 }
 
