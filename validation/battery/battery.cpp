@@ -39,17 +39,15 @@ BatteryOptions checked_options(const SamplerUnderTest& s, const BatteryOptions& 
 
 // Everything of a battery run that does not depend on the seed.
 struct Prepared {
-  std::vector<Real> mass;
-  KsCdfs ks;
+  Expected expected;
   std::vector<TestResult> deterministic;
 };
 
 Prepared prepare(const SamplerUnderTest& s, const BatteryOptions& o) {
   Prepared p;
   if (o.progress) o.progress("quadrature", 0);
-  p.mass = bin_masses(s, o);
-  p.ks = ks_cdfs(s, o);
-  p.deterministic.push_back(pdf_integral(s, o, p.mass));
+  p.expected = expected_integrals(s, o);
+  p.deterministic.push_back(pdf_integral(s, o, p.expected));
   p.deterministic.push_back(pdf_consistency(s, o));
   for (TestResult& r : normalizations(s)) p.deterministic.push_back(std::move(r));
   return p;
@@ -59,8 +57,8 @@ Prepared prepare(const SamplerUnderTest& s, const BatteryOptions& o) {
 std::vector<TestResult> run_seed(const SamplerUnderTest& s, const BatteryOptions& o, const Prepared& p) {
   std::vector<TestResult> out;
   Draws d = draw(s, o);
-  out.push_back(chi_square(s, o, d, p.mass));
-  ks_tests(s, p.ks, d, out);
+  out.push_back(chi_square(s, o, d, p.expected));
+  ks_tests(s, p.expected.ks, d, out);
   out.insert(out.end(), p.deterministic.begin(), p.deterministic.end());
   return out;
 }

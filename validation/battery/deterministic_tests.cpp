@@ -9,9 +9,9 @@
 
 namespace warpcheck::validation::battery {
 
-TestResult pdf_integral(const SamplerUnderTest& s, const BatteryOptions& o, const std::vector<Real>& mass) {
+TestResult pdf_integral(const SamplerUnderTest& s, const BatteryOptions& o, const Expected& e) {
   TestResult r = make_result(s, "pdf-integral");
-  const Real inside = std::accumulate(mass.begin(), mass.end(), Real(0));
+  const Real inside = std::accumulate(e.mass.begin(), e.mass.end(), Real(0));
   // The rest of the sphere: t from 1 (the cap's edge) to 2 / omc (the antipode).
   const Real outside = integrate_cap_region(s.pdf, s.bounding_cap, 1, 2 / s.bounding_cap.one_minus_cos, 0, kTwoPi<Real>,
                                             o.quadrature_tolerance, o.azimuth_bins, 1, s.boundary_planes);
@@ -21,7 +21,7 @@ TestResult pdf_integral(const SamplerUnderTest& s, const BatteryOptions& o, cons
   std::ostringstream detail;
   detail.precision(12);
   detail << "integral " << double(total) << " (outside the bounding cap " << double(outside) << "), tolerance "
-         << double(s.tolerance);
+         << double(s.tolerance) << "; inside by " << e.quadrature;
   r.detail = detail.str();
   return r;
 }

@@ -7,11 +7,12 @@
 #include <numeric>
 #include <sstream>
 
+#include "battery/cap_grid.h"
 #include "battery/tests.h"
 
 namespace warpcheck::validation::battery {
 
-std::vector<Real> bin_masses(const SamplerUnderTest& s, const BatteryOptions& o) {
+std::vector<Real> reference_bin_masses(const SamplerUnderTest& s, const BatteryOptions& o) {
   const int R = o.radial_bins, A = o.azimuth_bins;
   std::vector<Real> mass(std::size_t(R) * A);
   parallel_for(mass.size(), thread_count(o), [&](std::size_t k) {
@@ -22,8 +23,8 @@ std::vector<Real> bin_masses(const SamplerUnderTest& s, const BatteryOptions& o)
   return mass;
 }
 
-TestResult chi_square(const SamplerUnderTest& s, const BatteryOptions& o, const Draws& d,
-                      const std::vector<Real>& mass) {
+TestResult chi_square(const SamplerUnderTest& s, const BatteryOptions& o, const Draws& d, const Expected& ex) {
+  const std::vector<Real>& mass = ex.mass;
   TestResult r = make_result(s, "chi2");
   const Real n = Real(o.samples);
   // Mass the pdf puts outside the cap (or nowhere): the complement of what the bins hold. Declined and
@@ -84,7 +85,7 @@ TestResult chi_square(const SamplerUnderTest& s, const BatteryOptions& o, const 
     boost::math::chi_squared dist(dof);
     r.p_value = double(boost::math::cdf(boost::math::complement(dist, double(chi2))));
     detail << "dof " << dof << ", " << mass.size() << " bins (" << o.radial_bins << "x" << o.azimuth_bins << "), "
-           << pooled << " pooled";
+           << pooled << " pooled; expected counts by " << ex.quadrature;
   }
   r.detail = detail.str();
   return r;
@@ -124,17 +125,25 @@ TestResult kolmogorov_smirnov(const SamplerUnderTest& s, std::string name, std::
 
 }  // namespace
 
-KsCdfs ks_cdfs(const SamplerUnderTest& s, const BatteryOptions& o) {
+KsCdfs ks_nodes(const BatteryOptions& o) {
+  const int M = o.ks_cdf_nodes;
+  // Radial nodes clustered at both ends (Chebyshev-Lobatto), where the densities of visible-area and
+  // horizon-cut samplers are singular or steep; azimuth nodes equally spaced.
+  KsCdfs c;
+  c.xr.resize(std::size_t(M) + 1), c.xa.resize(std::size_t(M) + 1);
+  for (int k = 0; k <= M; ++k) {
+    c.xr[std::size_t(k)] = (1 - std::cos(kPi<Real> * k / M)) / 2;
+    c.xa[std::size_t(k)] = Real(k) / M;
+  }
+  c.xr.front() = 0, c.xr.back() = 1;
+  return c;
+}
+
+KsCdfs reference_ks_cdfs(const SamplerUnderTest& s, const BatteryOptions& o) {
   const int M = o.ks_cdf_nodes;
   const Cap<Real>& cap = s.bounding_cap;
-  // Radial marginal: nodes clustered at both ends (Chebyshev-Lobatto), where the densities of visible-area
-  // and horizon-cut samplers are singular or steep, so that linear interpolation stays far below 1/sqrt(n).
-  std::vector<Real> xr(M + 1), xa(M + 1), dr(M, 0), da(M, 0);
-  for (int k = 0; k <= M; ++k) {
-    xr[k] = (1 - std::cos(kPi<Real> * k / M)) / 2;
-    xa[k] = Real(k) / M;
-  }
-  xr[0] = 0, xr[M] = 1;
+  KsCdfs nodes = ks_nodes(o);
+  std::vector<Real> xr = std::move(nodes.xr), xa = std::move(nodes.xa), dr(M, 0), da(M, 0);
   // The CDFs need far less than the bins: KS at 1e7 samples resolves D ~ 1.36 / sqrt(n) = 4e-4, and slab errors
   // of 1e-6 relative sum to at most 1e-6 in F. Each of the 1024 azimuth slabs spans the whole cap, silhouette
   // included, so this is where a tight tolerance costs most. Each slab's radial lines start with one panel per

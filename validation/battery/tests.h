@@ -22,23 +22,46 @@ std::string format_g(double v, int prec);
 
 // ---- Statistical (statistical_tests.cpp) ---------------------------------------------------------------------
 
-// Expected mass of each chi-square bin, by quadrature of the pdf (row-major [radial][azimuth]).
-std::vector<Real> bin_masses(const SamplerUnderTest& s, const BatteryOptions& o);
-TestResult chi_square(const SamplerUnderTest& s, const BatteryOptions& o, const Draws& d,
-                      const std::vector<Real>& mass);
-
 // The two marginal CDFs of the KS tests, known at nodes (seed-independent: computed once per sampler).
 struct KsCdfs {
   std::vector<Real> xr, Fr, xa, Fa;
 };
-KsCdfs ks_cdfs(const SamplerUnderTest& s, const BatteryOptions& o);
+// The nodes xr (t, Chebyshev-Lobatto) and xa (phi / 2 pi, equally spaced), without the CDFs.
+KsCdfs ks_nodes(const BatteryOptions& o);
+
+// ---- Expected counts (expected.cpp) ---------------------------------------------------------------------------
+
+// How far errors `error` of the expected counts `expected` move the chi-square statistic's mean, pooling bins as
+// chi_square does, and the most that is allowed: 1e-3 of the statistic's standard deviation sqrt(2 (bins - 1)).
+Real chi_square_shift(const std::vector<Real>& expected, const std::vector<Real>& error, Real min_expected);
+Real chi_square_shift_budget(int bins);
+// The absolute accuracy of a KS CDF that moves D by at most 1e-3 of its critical value at n samples.
+Real ks_cdf_tolerance(std::uint64_t n);
+
+// The pdf's integrals the statistical tests compare with: the mass of each chi-square bin (row-major
+// [radial][azimuth]) and the KS CDFs, by the grid quadrature (cap_grid.h) when the difference of its two orders
+// of integration, taken as its error, is within the bounds above and the pdf integral's tolerance / 10, else by
+// reference_bin_masses and
+// reference_ks_cdfs (or by those alone with options.reference_quadrature).
+struct Expected {
+  std::vector<Real> mass;
+  KsCdfs ks;
+  std::string quadrature;  // which quadrature, and why, for the tests' details
+  Real inside_error = 0;   // the grid's two estimates of the integral over the cap differ by this
+};
+Expected expected_integrals(const SamplerUnderTest& s, const BatteryOptions& o);
+// The nested adaptive quadrature of each bin and of each KS slab (integrate_cap_region), to tolerance
+// options.quadrature_tolerance: slow, and what the grid is tested against.
+std::vector<Real> reference_bin_masses(const SamplerUnderTest& s, const BatteryOptions& o);
+KsCdfs reference_ks_cdfs(const SamplerUnderTest& s, const BatteryOptions& o);
+
+TestResult chi_square(const SamplerUnderTest& s, const BatteryOptions& o, const Draws& d, const Expected& e);
 // Appends ks-radial and ks-azimuth; consumes the draws' coordinates.
 void ks_tests(const SamplerUnderTest& s, const KsCdfs& c, Draws& d, std::vector<TestResult>& out);
 
 // ---- Deterministic (deterministic_tests.cpp) -----------------------------------------------------------------
 
-// mass: bin_masses, the integral of the pdf over the bounding cap.
-TestResult pdf_integral(const SamplerUnderTest& s, const BatteryOptions& o, const std::vector<Real>& mass);
+TestResult pdf_integral(const SamplerUnderTest& s, const BatteryOptions& o, const Expected& e);
 TestResult pdf_consistency(const SamplerUnderTest& s, const BatteryOptions& o);
 // One result per declared Normalization.
 std::vector<TestResult> normalizations(const SamplerUnderTest& s);

@@ -34,7 +34,8 @@ struct BatteryOptions {
   int radial_bins = 16, azimuth_bins = 32;  // chi-square grid: 512 equal-area bins over the bounding cap
   double min_expected = 5;                  // bins expected to hold fewer samples are pooled
   int ks_cdf_nodes = 1024;                  // nodes of the quadrature-computed marginal CDFs (D is taken there)
-  double quadrature_tolerance = 1e-8;       // relative tolerance of every region integral (see integrate_cap_region)
+  double quadrature_tolerance = 1e-8;       // relative tolerance of every 1D rule of the quadrature
+  bool reference_quadrature = false;        // nested adaptive quadrature of every bin and KS slab (slow)
   int consistency_points = 2048;            // primary-sample points of the pdf/Jacobian check
   int threads = 0;                          // 0: hardware concurrency
   // Called with (phase, fraction done) during long work; may be empty.

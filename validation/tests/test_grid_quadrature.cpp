@@ -1,0 +1,128 @@
+// Specifications of the battery's expected counts: the grid quadrature (cap_grid.h) against densities whose bin
+// masses and CDFs are known in closed form, and the bounds that decide when its result is used (expected.cpp).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <numeric>
+
+#include "battery/cap_grid.h"
+#include "battery/tests.h"
+#include "tests/quadrature_fixtures.h"
+
+namespace warpcheck::validation {
+namespace {
+
+using battery::CapGrid;
+using battery::CapGridSpec;
+
+SamplerUnderTest density_on(const Cap<Real>& cap, std::function<Real(const Vec3L&)> pdf) {
+  SamplerUnderTest s;
+  s.kernel = "density", s.scalar = "double", s.config = "fixture";
+  s.sample = [](double, double) { return Sample{}; };
+  s.pdf = std::move(pdf);
+  s.bounding_cap = cap;
+  return s;
+}
+
+CapGrid grid_of(const SamplerUnderTest& s) {
+  const BatteryOptions o;
+  const battery::KsCdfs nodes = battery::ks_nodes(o);
+  CapGridSpec spec;
+  spec.xr = nodes.xr, spec.xa = nodes.xa;
+  return battery::integrate_cap_grid(s, spec);
+}
+
+// The chi-square shift that errors `mass - exact` of the bin masses cause at 10^7 samples, over its budget.
+double shift_over_budget(const std::vector<Real>& mass, const std::vector<Real>& exact) {
+  std::vector<Real> e(mass.size()), err(mass.size());
+  for (std::size_t k = 0; k < mass.size(); ++k) e[k] = 1e7L * exact[k], err[k] = 1e7L * (mass[k] - exact[k]);
+  return double(battery::chi_square_shift(e, err, 5) / battery::chi_square_shift_budget(int(mass.size())));
+}
+
+TEST(GridQuadrature, AUniformConesBinsAreEqualAndItsCdfsAreTheNodesThemselves) {
+  const SamplerUnderTest s = density_on(kBounding, [](const Vec3L& w) {
+    return kBounding.contains(w, 1e-15L) ? 1 / (kTwoPi<Real> * kBounding.one_minus_cos) : Real(0);
+  });
+  const CapGrid g = grid_of(s);
+  const battery::KsCdfs nodes = battery::ks_nodes(BatteryOptions{});
+  for (std::size_t k = 0; k < g.bins.size(); ++k) {
+    EXPECT_NEAR(double(g.bins[k]), 1.0 / 512, 1e-15) << k;
+    EXPECT_NEAR(double(g.bins_check[k]), 1.0 / 512, 1e-15) << k;
+  }
+  for (std::size_t k = 0; k < nodes.xr.size(); ++k) {
+    EXPECT_NEAR(double(g.Fr[k]), double(nodes.xr[k]), 1e-14) << k;
+    EXPECT_NEAR(double(g.Fa[k]), double(nodes.xa[k]), 1e-14) << k;
+  }
+}
+
+// The tilted cap's edge is a small circle, not a declared boundary plane: the grid finds it by halving the
+// slabs that bend.
+TEST(GridQuadrature, BinsOfADensityWithAnUndeclaredObliqueJumpMeetTheChiSquareBoundAtTenToTheSeven) {
+  const TiltedCap c;
+  const SamplerUnderTest s = density_on(kBounding, [&](const Vec3L& w) { return c.pdf(w); });
+  const CapGrid g = grid_of(s);
+  std::vector<Real> exact;
+  for (int ri = 0; ri < 16; ++ri)
+    for (int ai = 0; ai < 32; ++ai)
+      exact.push_back(
+          c.bin_mass(Real(ri) / 16, Real(ri + 1) / 16, kTwoPi<Real> * ai / 32, kTwoPi<Real> * (ai + 1) / 32));
+  EXPECT_LT(shift_over_budget(g.bins, exact), 1);
+  EXPECT_LT(shift_over_budget(g.bins_check, exact), 1);
+}
+
+TEST(GridQuadrature, TheRadialCdfOfAnInverseSquareRootSingularityAtTheCapsEdgeMeetsTheKsBound) {
+  // f proportional to 1 / sqrt(1 - t) (the visible-area sampler's silhouette): F(t) = 1 - sqrt(1 - t).
+  const SamplerUnderTest s = density_on(kBounding, [](const Vec3L& w) {
+    const Real t = (w - kBounding.axis).squaredNorm() / 2 / kBounding.one_minus_cos;
+    return t < 1 ? 1 / (2 * std::sqrt(1 - t) * kTwoPi<Real> * kBounding.one_minus_cos) : Real(0);
+  });
+  const CapGrid g = grid_of(s);
+  const battery::KsCdfs nodes = battery::ks_nodes(BatteryOptions{});
+  Real worst = 0;
+  for (std::size_t k = 0; k < nodes.xr.size(); ++k)
+    worst = std::max(worst, std::abs(g.Fr[k] - (1 - std::sqrt(1 - nodes.xr[k]))));
+  EXPECT_LT(double(worst), double(battery::ks_cdf_tolerance(10'000'000)));
+}
+
+TEST(GridQuadrature, ASliversBinsSumToItsExactAreaWhenItsEdgesAreDeclared) {
+  const Cap<Real> cap{Vec3L(0, 0, 1), Real(0.05)};
+  auto dir = [](Real theta, Real phi) {
+    return Vec3L(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta));
+  };
+  const Vec3L a = dir(Real(0.3), Real(0.1)), b = dir(Real(0.3), Real(2.6));
+  const Vec3L c = ((a + b).normalized() + Real(3e-3) * a.cross(b).normalized()).normalized();
+  const std::vector<Vec3L> planes{a.cross(b).normalized(), b.cross(c).normalized(), c.cross(a).normalized()};
+  const Real orient = planes[0].dot(c) > 0 ? 1 : -1;
+  const Real area = 2 * std::atan2(std::abs(a.dot(b.cross(c))), 1 + a.dot(b) + b.dot(c) + c.dot(a));
+  SamplerUnderTest s = density_on(cap, [&](const Vec3L& w) {
+    for (const Vec3L& m : planes)
+      if (orient * m.dot(w) < 0) return Real(0);
+    return 1 / area;
+  });
+  s.boundary_planes = planes;
+  const CapGrid g = grid_of(s);
+  // Required: a tenth of the pdf-integral test's tolerance 1e-6 (expected.cpp).
+  const double lines = double(std::accumulate(g.bins.begin(), g.bins.end(), Real(0)) - 1);
+  const double rings = double(std::accumulate(g.bins_check.begin(), g.bins_check.end(), Real(0)) - 1);
+  std::printf("sliver's integral - 1: lines %.2g, rings %.2g\n", lines, rings);
+  EXPECT_LT(std::abs(lines), 1e-7);
+  EXPECT_LT(std::abs(rings), 1e-7);
+}
+
+TEST(ChiSquareShift, IsTheSumOfRelativeErrorPlusExpectedTimesItsSquareWithSmallBinsPooled) {
+  // e = 100, error 1: 0.01 + 100 * 0.01^2 = 0.02. Two bins of 2 with errors 0.1 pool to 4 and 0.2: 0.05 + 4 *
+  // 0.05^2 = 0.06.
+  EXPECT_NEAR(double(battery::chi_square_shift({100}, {1}, 5)), 0.02, 1e-15);
+  EXPECT_NEAR(double(battery::chi_square_shift({100, 2, 2}, {1, 0.1L, 0.1L}, 5)), 0.08, 1e-15);
+  EXPECT_NEAR(double(battery::chi_square_shift({100}, {-1}, 5)), 0.02, 1e-15);  // either sign
+  // The budget: 1e-3 of sqrt(2 (512 - 1)).
+  EXPECT_NEAR(double(battery::chi_square_shift_budget(512)), 1e-3 * std::sqrt(1022.0), 1e-15);
+}
+
+TEST(KsCdfTolerance, IsOneThousandthOfTheCriticalDistanceAtTheSampleCount) {
+  EXPECT_NEAR(double(battery::ks_cdf_tolerance(1'000'000)), 1.36e-6, 1e-18);
+}
+
+}  // namespace
+}  // namespace warpcheck::validation
