@@ -1,6 +1,7 @@
 // The battery's random streams, threads and draws (drawing.h).
 #include "battery/drawing.h"
 
+#include <array>
 #include <cfloat>
 #include <cmath>
 #include <mutex>
@@ -40,7 +41,10 @@ int thread_count(const BatteryOptions& o) {
   return std::max(1u, std::thread::hardware_concurrency());
 }
 
+// Each chunk of kChunk samples has its own stream (the unit of work of a thread); within it the sampler is called
+// on blocks of kBlock primary samples, drawn in the stream's order (u0, u1 of the first sample, then the next).
 constexpr std::uint64_t kChunk = 1 << 16;
+constexpr std::size_t kBlock = 256;
 
 Draws draw(const SamplerUnderTest& s, const BatteryOptions& o) {
   const int R = o.radial_bins, A = o.azimuth_bins;
@@ -60,30 +64,37 @@ Draws draw(const SamplerUnderTest& s, const BatteryOptions& o) {
     std::vector<std::uint64_t> local(d.counts.size(), 0);
     std::uint64_t outside = 0, declined = 0, non_finite = 0;
     const std::size_t end = std::min<std::size_t>(o.samples, (c + 1) * kChunk);
-    for (std::size_t i = c * kChunk; i < end; ++i) {
-      const double u0 = uniform01(g), u1 = uniform01(g);
-      const Sample x = s.sample(u0, u1);
-      constexpr double kInf = std::numeric_limits<double>::infinity();
-      if (!x.valid) {
-        ++declined, d.t[i] = kInf, d.phi[i] = kInf;
-        continue;
+    std::array<double, kBlock> u0, u1;
+    std::array<Sample, kBlock> block;
+    for (std::size_t b = c * kChunk; b < end; b += kBlock) {
+      const std::size_t m = std::min(kBlock, end - b);
+      for (std::size_t j = 0; j < m; ++j) u0[j] = uniform01(g), u1[j] = uniform01(g);
+      sample_many(s, {u0.data(), m}, {u1.data(), m}, {block.data(), m});
+      for (std::size_t j = 0; j < m; ++j) {
+        const std::size_t i = b + j;
+        const Sample& x = block[j];
+        constexpr double kInf = std::numeric_limits<double>::infinity();
+        if (!x.valid) {
+          ++declined, d.t[i] = kInf, d.phi[i] = kInf;
+          continue;
+        }
+        if (!all_finite(x.direction) || !std::isfinite(x.pdf)) {
+          ++non_finite, d.t[i] = kInf, d.phi[i] = kInf;
+          continue;
+        }
+        Real t, phi;
+        cap_coordinates(s.bounding_cap, x.direction.normalized(), t, phi);
+        if (!(t <= 1 + slack)) {
+          ++outside, d.t[i] = kInf, d.phi[i] = kInf;
+          continue;
+        }
+        t = std::min<Real>(t, 1);
+        d.t[i] = double(t);
+        d.phi[i] = double(phi / kTwoPi<Real>);
+        const int ri = std::min(R - 1, int(t * R));
+        const int ai = std::min(A - 1, int(phi / kTwoPi<Real> * A));
+        ++local[std::size_t(ri) * A + ai];
       }
-      if (!all_finite(x.direction) || !std::isfinite(x.pdf)) {
-        ++non_finite, d.t[i] = kInf, d.phi[i] = kInf;
-        continue;
-      }
-      Real t, phi;
-      cap_coordinates(s.bounding_cap, x.direction.normalized(), t, phi);
-      if (!(t <= 1 + slack)) {
-        ++outside, d.t[i] = kInf, d.phi[i] = kInf;
-        continue;
-      }
-      t = std::min<Real>(t, 1);
-      d.t[i] = double(t);
-      d.phi[i] = double(phi / kTwoPi<Real>);
-      const int ri = std::min(R - 1, int(t * R));
-      const int ai = std::min(A - 1, int(phi / kTwoPi<Real> * A));
-      ++local[std::size_t(ri) * A + ai];
     }
     std::lock_guard lock(m);
     for (std::size_t k = 0; k < local.size(); ++k) d.counts[k] += local[k];
