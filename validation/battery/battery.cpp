@@ -34,6 +34,7 @@ BatteryOptions checked_options(const SamplerUnderTest& s, const BatteryOptions& 
     throw std::invalid_argument("SamplerUnderTest needs a bounding cap with 0 < 1 - cos(half-angle) <= 2");
   if (o.samples < 1000 || o.radial_bins < 1 || o.azimuth_bins < 1 || o.ks_cdf_nodes < 16)
     throw std::invalid_argument("battery options out of range (samples >= 1000, bins >= 1, ks_cdf_nodes >= 16)");
+  check_block_forms(s);
   return o;
 }
 

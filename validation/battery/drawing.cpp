@@ -5,6 +5,8 @@
 #include <cfloat>
 #include <cmath>
 #include <mutex>
+#include <sstream>
+#include <stdexcept>
 
 namespace warpcheck::validation::battery {
 namespace {
@@ -39,6 +41,58 @@ Real scalar_epsilon(const std::string& scalar) {
 int thread_count(const BatteryOptions& o) {
   if (o.threads > 0) return o.threads;
   return std::max(1u, std::thread::hardware_concurrency());
+}
+
+namespace {
+
+// Equal values, zeros of the same sign; any two NaNs agree.
+bool same(Real a, Real b) { return (a == b && std::signbit(a) == std::signbit(b)) || (std::isnan(a) && std::isnan(b)); }
+
+bool same(const Sample& a, const Sample& b) {
+  return a.valid == b.valid && same(a.pdf, b.pdf) && same(a.direction.x(), b.direction.x()) &&
+         same(a.direction.y(), b.direction.y()) && same(a.direction.z(), b.direction.z());
+}
+
+[[noreturn]] void block_form_disagrees(const SamplerUnderTest& s, const char* block, const char* single,
+                                       const std::string& where) {
+  throw std::invalid_argument("SamplerUnderTest " + s.kernel + " / " + s.scalar + " / " + s.config + ": " + block +
+                              " disagrees with " + single + " at " + where + " (was " + single +
+                              " replaced after bind_kernel? replace or clear " + block + " too)");
+}
+
+}  // namespace
+
+void check_block_forms(const SamplerUnderTest& s) {
+  // Primary samples spread over the square, one near each corner: the directions where a replaced sample or pdf
+  // (a negative control's tilt, a test's wrapper) differs from the bound kernel's.
+  constexpr std::array<double, 8> u0{0.5, 0.125, 0.875, 0.3, 0.7, 0.01, 0.99, 0.999},
+      u1{0.5, 0.875, 0.125, 0.7, 0.3, 0.02, 0.98, 0.001};
+  std::array<Sample, u0.size()> block;
+  if (s.sample_block) {
+    s.sample_block(u0, u1, block);
+    for (std::size_t i = 0; i < u0.size(); ++i)
+      if (!same(block[i], s.sample(u0[i], u1[i])))
+        block_form_disagrees(s, "sample_block", "sample",
+                             "u = (" + std::to_string(u0[i]) + ", " + std::to_string(u1[i]) + ")");
+  } else {
+    for (std::size_t i = 0; i < u0.size(); ++i) block[i] = s.sample(u0[i], u1[i]);
+  }
+  if (!s.pdf_block) return;
+  // The samples' directions (where the pdf is nonzero, however thin the support) and points of the bounding cap.
+  std::vector<Vec3L> w;
+  for (const Sample& x : block)
+    if (x.valid && all_finite(x.direction)) w.push_back(x.direction);
+  for (Real t : {Real(0), Real(0.5), Real(1)})
+    for (Real phi : {Real(0.5), Real(2.5), Real(4.5)}) w.push_back(cap_direction(s.bounding_cap, t, phi));
+  std::vector<Real> p(w.size());
+  s.pdf_block(w, p);
+  for (std::size_t i = 0; i < w.size(); ++i)
+    if (!same(p[i], s.pdf(w[i]))) {
+      std::ostringstream where;
+      where.precision(17);
+      where << "w = (" << double(w[i].x()) << ", " << double(w[i].y()) << ", " << double(w[i].z()) << ")";
+      block_form_disagrees(s, "pdf_block", "pdf", where.str());
+    }
 }
 
 // Each chunk of kChunk samples has its own stream (the unit of work of a thread); within it the sampler is called

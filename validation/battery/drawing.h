@@ -35,6 +35,11 @@ template <class F> void parallel_for(std::size_t n, int threads, F&& body) {
   for (auto& t : pool) t.join();
 }
 
+// Throws std::invalid_argument when a block form of the sampler (sample_block, pdf_block) disagrees with its
+// single form (sample, pdf) at a few fixed primary samples and directions, bit for bit: a block form that
+// bind_kernel filled and that was left behind when sample or pdf was replaced would otherwise be tested instead.
+void check_block_forms(const SamplerUnderTest& s);
+
 struct Draws {
   std::vector<double> t, phi;         // cap coordinates; +inf for samples outside the cap or declined
   std::vector<std::uint64_t> counts;  // chi-square grid counts
