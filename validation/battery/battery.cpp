@@ -59,7 +59,7 @@ Prepared prepare(const SamplerUnderTest& s, const BatteryOptions& o) {
 // The seed's draws and the statistical tests on them, then the deterministic results: the order of run_battery.
 std::vector<TestResult> run_seed(const SamplerUnderTest& s, const BatteryOptions& o, const Prepared& p) {
   std::vector<TestResult> out;
-  Draws d = draw(s, o);
+  const Draws d = draw(s, o, p.ks.xr, p.ks.xa);
   out.push_back(chi_square(s, o, d, p.mass));
   ks_tests(s, p.ks, d, out);
   out.insert(out.end(), p.deterministic.begin(), p.deterministic.end());

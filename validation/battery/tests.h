@@ -32,8 +32,8 @@ struct KsCdfs {
   std::vector<Real> xr, Fr, xa, Fa;
 };
 KsCdfs ks_cdfs(const SamplerUnderTest& s, const BatteryOptions& o);
-// Appends ks-radial and ks-azimuth; consumes the draws' coordinates.
-void ks_tests(const SamplerUnderTest& s, const KsCdfs& c, Draws& d, std::vector<TestResult>& out);
+// Appends ks-radial and ks-azimuth, from the draws' counts per slab between c's nodes (drawn with c.xr and c.xa).
+void ks_tests(const SamplerUnderTest& s, const KsCdfs& c, const Draws& d, std::vector<TestResult>& out);
 
 // ---- Deterministic (deterministic_tests.cpp) -----------------------------------------------------------------
 
