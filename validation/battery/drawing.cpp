@@ -126,13 +126,13 @@ CapBinner::CapBinner(const SamplerUnderTest& s, const BatteryOptions& o, const s
   // component of the normalised w within 6.5 u, so e = w - axis is within 7.5 u + u |e|. Then t = |e|^2 / (2 omc),
   // with |e| = sqrt(2 omc t), is within 7.5 u sqrt(2 t / omc) + 28 u^2 / omc + 7.5 u t: for t <= 2 (where
   // place_fast applies) 15 u / sqrt(omc) + 28 u^2 / omc + 15 u, of which t_error_ is 4 times. The frame's
-  // coordinates (x, y) are within 15 u, so for sin(theta) = |(x, y)| >= 2^-20 the azimuth is within
-  // 15 u 2^20 = 1.7e-9 plus azimuth_fraction's error, of which phi_error_ is 2.5 times. Both margins also cover the
+  // coordinates (x, y) are within 15 u, so for sin(theta) = |(x, y)| >= 2^-22 the azimuth is within
+  // 15 u 2^22 = 7e-9 plus azimuth_fraction's error, of which phi_error_ is 2.5 times. Both margins also cover the
   // rounding of the comparisons with the edges (a few u) and place_exact's own (long double) rounding.
   constexpr double u = 0x1p-53;
   const double d_omc = double(omc);
   t_error_ = 64 * u * (1 + 1 / std::sqrt(d_omc)) + 128 * u * u / d_omc;
-  phi_error_ = 2.5 * (kAtanError + 16 * u * 0x1p20) / kTwoPi<double>;
+  phi_error_ = 2.5 * (kAtanError + 16 * u * 0x1p22) / kTwoPi<double>;
 }
 
 Placement CapBinner::place_exact(const Vec3L& direction) const {
@@ -158,10 +158,10 @@ void CapBinner::fast_coordinates(std::size_t n, const double* x, const double* y
     const double ex = wx - axis_[0], ey = wy - axis_[1], ez = wz - axis_[2];
     const double lx = wx * fx_[0] + wy * fx_[1] + wz * fx_[2], ly = wx * fy_[0] + wy * fy_[1] + wz * fy_[2];
     const double ti = (ex * ex + ey * ey + ez * ez) * half_over_omc_, ai = azimuth_fraction(lx, ly);
-    // NaN where the bounds do not hold: a direction far from unit length (or beyond double's range), or within 2^-20
+    // NaN where the bounds do not hold: a direction far from unit length (or beyond double's range), or within 2^-22
     // of the axis (a select between constants, added: ti + 0 is ti).
     t[i] = ti + (std::abs(delta) < 0x1p-14 ? 0.0 : kNaN);
-    a[i] = ai + (lx * lx + ly * ly >= 0x1p-40 ? 0.0 : kNaN);
+    a[i] = ai + (lx * lx + ly * ly >= 0x1p-44 ? 0.0 : kNaN);
   }
 }
 
