@@ -34,6 +34,7 @@ BatteryOptions checked_options(const SamplerUnderTest& s, const BatteryOptions& 
     throw std::invalid_argument("SamplerUnderTest needs a bounding cap with 0 < 1 - cos(half-angle) <= 2");
   if (o.samples < 1000 || o.radial_bins < 1 || o.azimuth_bins < 1 || o.ks_cdf_nodes < 16)
     throw std::invalid_argument("battery options out of range (samples >= 1000, bins >= 1, ks_cdf_nodes >= 16)");
+  check_block_forms(s);
   return o;
 }
 
@@ -56,7 +57,7 @@ Prepared prepare(const SamplerUnderTest& s, const BatteryOptions& o) {
 // The seed's draws and the statistical tests on them, then the deterministic results: the order of run_battery.
 std::vector<TestResult> run_seed(const SamplerUnderTest& s, const BatteryOptions& o, const Prepared& p) {
   std::vector<TestResult> out;
-  Draws d = draw(s, o);
+  const Draws d = draw(s, o, p.expected.ks.xr, p.expected.ks.xa);
   out.push_back(chi_square(s, o, d, p.expected));
   ks_tests(s, p.expected.ks, d, out);
   out.insert(out.end(), p.deterministic.begin(), p.deterministic.end());

@@ -1,9 +1,14 @@
 // The battery's random streams, threads and draws (drawing.h).
 #include "battery/drawing.h"
 
+#include <algorithm>
+#include <array>
 #include <cfloat>
 #include <cmath>
+#include <limits>
 #include <mutex>
+#include <sstream>
+#include <stdexcept>
 
 namespace warpcheck::validation::battery {
 namespace {
@@ -40,56 +45,230 @@ int thread_count(const BatteryOptions& o) {
   return std::max(1u, std::thread::hardware_concurrency());
 }
 
-constexpr std::uint64_t kChunk = 1 << 16;
+namespace {
 
-Draws draw(const SamplerUnderTest& s, const BatteryOptions& o) {
-  const int R = o.radial_bins, A = o.azimuth_bins;
-  Draws d;
-  d.t.resize(o.samples);
-  d.phi.resize(o.samples);
-  d.counts.assign(std::size_t(R) * A, 0);
+// Equal values, zeros of the same sign; any two NaNs agree.
+bool same(Real a, Real b) { return (a == b && std::signbit(a) == std::signbit(b)) || (std::isnan(a) && std::isnan(b)); }
+
+bool same(const Sample& a, const Sample& b) {
+  return a.valid == b.valid && same(a.pdf, b.pdf) && same(a.direction.x(), b.direction.x()) &&
+         same(a.direction.y(), b.direction.y()) && same(a.direction.z(), b.direction.z());
+}
+
+[[noreturn]] void block_form_disagrees(const SamplerUnderTest& s, const char* block, const char* single,
+                                       const std::string& where) {
+  throw std::invalid_argument("SamplerUnderTest " + s.kernel + " / " + s.scalar + " / " + s.config + ": " + block +
+                              " disagrees with " + single + " at " + where + " (was " + single +
+                              " replaced after bind_kernel? replace or clear " + block + " too)");
+}
+
+}  // namespace
+
+void check_block_forms(const SamplerUnderTest& s) {
+  // Primary samples spread over the square, one near each corner: the directions where a replaced sample or pdf
+  // (a negative control's tilt, a test's wrapper) differs from the bound kernel's.
+  constexpr std::array<double, 8> u0{0.5, 0.125, 0.875, 0.3, 0.7, 0.01, 0.99, 0.999},
+      u1{0.5, 0.875, 0.125, 0.7, 0.3, 0.02, 0.98, 0.001};
+  std::array<Sample, u0.size()> block;
+  if (s.sample_block) {
+    s.sample_block(u0, u1, block);
+    for (std::size_t i = 0; i < u0.size(); ++i)
+      if (!same(block[i], s.sample(u0[i], u1[i])))
+        block_form_disagrees(s, "sample_block", "sample",
+                             "u = (" + std::to_string(u0[i]) + ", " + std::to_string(u1[i]) + ")");
+  } else {
+    for (std::size_t i = 0; i < u0.size(); ++i) block[i] = s.sample(u0[i], u1[i]);
+  }
+  if (!s.pdf_block) return;
+  // The samples' directions (where the pdf is nonzero, however thin the support) and points of the bounding cap.
+  std::vector<Vec3L> w;
+  for (const Sample& x : block)
+    if (x.valid && all_finite(x.direction)) w.push_back(x.direction);
+  for (Real t : {Real(0), Real(0.5), Real(1)})
+    for (Real phi : {Real(0.5), Real(2.5), Real(4.5)}) w.push_back(cap_direction(s.bounding_cap, t, phi));
+  std::vector<Real> p(w.size());
+  s.pdf_block(w, p);
+  for (std::size_t i = 0; i < w.size(); ++i)
+    if (!same(p[i], s.pdf(w[i]))) {
+      std::ostringstream where;
+      where.precision(17);
+      where << "w = (" << double(w[i].x()) << ", " << double(w[i].y()) << ", " << double(w[i].z()) << ")";
+      block_form_disagrees(s, "pdf_block", "pdf", where.str());
+    }
+}
+
+SlabLocator::SlabLocator(const std::vector<Real>& nodes)
+    : x_(nodes.begin(), nodes.end()), first_(kBuckets + 1), last_(std::uint32_t(nodes.size() - 1)) {
+  if (x_.empty() || !std::is_sorted(x_.begin(), x_.end()))
+    throw std::logic_error("KS nodes must be increasing (as doubles)");
+  for (int j = 0; j <= kBuckets; ++j)
+    first_[j] = std::uint32_t(std::lower_bound(x_.begin(), x_.end(), double(j) / kBuckets) - x_.begin());
+  x_.push_back(std::numeric_limits<double>::infinity());  // so that x_[first_[j]] exists
+}
+
+CapBinner::CapBinner(const SamplerUnderTest& s, const BatteryOptions& o, const std::vector<Real>& ks_radial_nodes,
+                     const std::vector<Real>& ks_azimuth_nodes)
+    : cap_(s.bounding_cap),
+      rings_(o.radial_bins),
+      columns_(o.azimuth_bins),
+      radial_(ks_radial_nodes),
+      azimuth_(ks_azimuth_nodes) {
   // A sample may land a rounding error beyond the cap's edge: t's error is about eps * sqrt(2 / omc) (the
   // angle's error over the cap's angular radius). Within that slack it counts in the outermost ring.
-  const Real eps = scalar_epsilon(s.scalar);
-  const Real slack = 64 * eps * (1 + std::sqrt(2 / s.bounding_cap.one_minus_cos));
+  const Real omc = cap_.one_minus_cos;
+  slack_ = 64 * scalar_epsilon(s.scalar) * (1 + std::sqrt(2 / omc));
+  const Frame<Real> f = Frame<Real>::from_z(cap_.axis);
+  for (int i = 0; i < 3; ++i) axis_[i] = double(cap_.axis[i]), fx_[i] = double(f.x[i]), fy_[i] = double(f.y[i]);
+  half_over_omc_ = double(1 / (2 * omc));
+  inside_t_ = double(1 + slack_);
+  // Error bounds of place_fast's coordinates against place_exact's, u = 2^-53 (double's unit roundoff): the
+  // direction's components rounded to double and |d|^2 are within 2 u + 3 u, 1 / |d| within 4.5 u and each
+  // component of the normalised w within 6.5 u, so e = w - axis is within 7.5 u + u |e|. Then t = |e|^2 / (2 omc),
+  // with |e| = sqrt(2 omc t), is within 7.5 u sqrt(2 t / omc) + 28 u^2 / omc + 7.5 u t: for t <= 2 (where
+  // place_fast applies) 15 u / sqrt(omc) + 28 u^2 / omc + 15 u, of which t_error_ is 4 times. The frame's
+  // coordinates (x, y) are within 15 u, so for sin(theta) = |(x, y)| >= 2^-22 the azimuth is within
+  // 15 u 2^22 = 7e-9 plus azimuth_fraction's error, of which phi_error_ is 2.5 times. Both margins also cover the
+  // rounding of the comparisons with the edges (a few u) and place_exact's own (long double) rounding.
+  constexpr double u = 0x1p-53;
+  const double d_omc = double(omc);
+  t_error_ = 64 * u * (1 + 1 / std::sqrt(d_omc)) + 128 * u * u / d_omc;
+  phi_error_ = 2.5 * (kAtanError + 16 * u * 0x1p22) / kTwoPi<double>;
+}
+
+Placement CapBinner::place_exact(const Vec3L& direction) const {
+  Real t, phi;
+  cap_coordinates(cap_, direction.normalized(), t, phi);
+  if (!(t <= 1 + slack_)) return Placement{.outside = true};
+  t = std::min<Real>(t, 1);
+  const int ri = std::min(rings_ - 1, int(t * rings_));
+  const int ai = std::min(columns_ - 1, int(phi / kTwoPi<Real> * columns_));
+  return Placement{false, std::uint32_t(ri * columns_ + ai), radial_(double(t)), azimuth_(double(phi / kTwoPi<Real>))};
+}
+
+// Branch-free, so that the loop over a block vectorises.
+void CapBinner::fast_coordinates(std::size_t n, const double* x, const double* y, const double* z, double* t,
+                                 double* a) const {
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  for (std::size_t i = 0; i < n; ++i) {
+    // 1 / sqrt(1 + delta) by its series to delta^3: for |delta| < 2^-14 the rest is below (35/128) delta^4 < 0.03 u.
+    // (std::sqrt may set errno, a call that keeps the loop from vectorising.) delta = |d|^2 - 1 is exact (Sterbenz).
+    const double delta = x[i] * x[i] + y[i] * y[i] + z[i] * z[i] - 1;
+    const double inv = 1 - delta * (0.5 - delta * (0.375 - delta * 0.3125));
+    const double wx = x[i] * inv, wy = y[i] * inv, wz = z[i] * inv;
+    const double ex = wx - axis_[0], ey = wy - axis_[1], ez = wz - axis_[2];
+    const double lx = wx * fx_[0] + wy * fx_[1] + wz * fx_[2], ly = wx * fy_[0] + wy * fy_[1] + wz * fy_[2];
+    const double ti = (ex * ex + ey * ey + ez * ez) * half_over_omc_, ai = azimuth_fraction(lx, ly);
+    // NaN where the bounds do not hold: a direction far from unit length (or beyond double's range), or within 2^-22
+    // of the axis (a select between constants, added: ti + 0 is ti).
+    t[i] = ti + (std::abs(delta) < 0x1p-14 ? 0.0 : kNaN);
+    a[i] = ai + (lx * lx + ly * ly >= 0x1p-44 ? 0.0 : kNaN);
+  }
+}
+
+std::optional<Placement> CapBinner::place_coordinates(double t, double a) const {
+  if (!(t <= 2)) return std::nullopt;
+  const double t_lo = t - t_error_, t_hi = t + t_error_;
+  if (t_lo > inside_t_) return Placement{.outside = true};
+  if (!(t_hi <= inside_t_)) return std::nullopt;
+  // place_exact clamps t to 1 (the slack's samples count in the outermost ring and the last slab).
+  const double c = std::min(t, 1.0), c_lo = std::min(t_lo, 1.0), c_hi = std::min(t_hi, 1.0);
+  const int ri = std::min(rings_ - 1, int(c_lo * rings_));
+  const std::uint32_t rk = radial_(c);
+  if (ri != std::min(rings_ - 1, int(c_hi * rings_)) || !radial_.holds(rk, c_lo, c_hi)) return std::nullopt;
+  const double a_lo = a - phi_error_, a_hi = a + phi_error_;
+  if (!(a_lo > 0 && a_hi < 1)) return std::nullopt;  // at the seam
+  const int ai = std::min(columns_ - 1, int(a_lo * columns_));
+  const std::uint32_t ak = azimuth_(a);
+  if (ai != std::min(columns_ - 1, int(a_hi * columns_)) || !azimuth_.holds(ak, a_lo, a_hi)) return std::nullopt;
+  return Placement{false, std::uint32_t(ri * columns_ + ai), rk, ak};
+}
+
+std::optional<Placement> CapBinner::place_fast(const Vec3L& direction) const {
+  const double x = double(direction.x()), y = double(direction.y()), z = double(direction.z());
+  double t, a;
+  fast_coordinates(1, &x, &y, &z, &t, &a);
+  return place_coordinates(t, a);
+}
+
+// Each chunk of kChunk samples has its own stream (the unit of work of a thread); within it the sampler is called
+// on blocks of kBlock primary samples, drawn in the stream's order (u0, u1 of the first sample, then the next).
+// Every count is a sum of the chunks' integer counts: the same whatever the thread count and order.
+constexpr std::uint64_t kChunk = 1 << 16;
+constexpr std::size_t kBlock = 256;
+
+namespace {
+
+// One chunk's counts (Draws' fields), merged into the draws under a lock.
+struct Tally {
+  std::vector<std::uint64_t> counts, radial, azimuth;
+  std::uint64_t outside = 0, declined = 0, non_finite = 0, exact = 0;
+
+  explicit Tally(const Draws& d)
+      : counts(d.counts.size()), radial(d.radial_slabs.size()), azimuth(d.azimuth_slabs.size()) {}
+
+  // The block's samples placed by place_fast in two passes (the coordinates of the whole block, then each
+  // placement), or by place_exact.
+  void add(const CapBinner& b, std::span<const Sample> block) {
+    std::array<double, kBlock> x, y, z, t, a;
+    std::array<bool, kBlock> placed;
+    for (std::size_t i = 0; i < block.size(); ++i) {
+      const Sample& s = block[i];
+      const bool finite = all_finite(s.direction) && std::isfinite(s.pdf);
+      declined += !s.valid, non_finite += s.valid && !finite;
+      placed[i] = s.valid && finite;
+      x[i] = placed[i] ? double(s.direction.x()) : 0, y[i] = placed[i] ? double(s.direction.y()) : 0;
+      z[i] = placed[i] ? double(s.direction.z()) : 0;
+    }
+    b.fast_coordinates(block.size(), x.data(), y.data(), z.data(), t.data(), a.data());
+    for (std::size_t i = 0; i < block.size(); ++i) {
+      if (!placed[i]) continue;
+      std::optional<Placement> p = b.place_coordinates(t[i], a[i]);
+      if (!p) p = b.place_exact(block[i].direction), ++exact;
+      if (p->outside) {
+        ++outside;
+        continue;
+      }
+      ++counts[p->bin], ++radial[p->radial_slab], ++azimuth[p->azimuth_slab];
+    }
+  }
+
+  void merge_into(Draws& d) const {
+    auto add_to = [](std::vector<std::uint64_t>& to, const std::vector<std::uint64_t>& from) {
+      for (std::size_t k = 0; k < to.size(); ++k) to[k] += from[k];
+    };
+    add_to(d.counts, counts), add_to(d.radial_slabs, radial), add_to(d.azimuth_slabs, azimuth);
+    d.outside += outside, d.declined += declined, d.non_finite += non_finite, d.placed_exactly += exact;
+  }
+};
+
+}  // namespace
+
+Draws draw(const SamplerUnderTest& s, const BatteryOptions& o, const std::vector<Real>& ks_radial_nodes,
+           const std::vector<Real>& ks_azimuth_nodes) {
+  const CapBinner binner(s, o, ks_radial_nodes, ks_azimuth_nodes);
+  Draws d;
+  d.n = o.samples;
+  d.counts.assign(std::size_t(o.radial_bins) * o.azimuth_bins, 0);
+  d.radial_slabs.assign(binner.radial().slabs(), 0);
+  d.azimuth_slabs.assign(binner.azimuth().slabs(), 0);
   const std::size_t chunks = (o.samples + kChunk - 1) / kChunk;
   std::mutex m;
-  std::atomic<std::size_t> done{0};
+  std::size_t done = 0;
   parallel_for(chunks, thread_count(o), [&](std::size_t c) {
     std::mt19937_64 g = stream(o.seed, s, 1, c);
-    std::vector<std::uint64_t> local(d.counts.size(), 0);
-    std::uint64_t outside = 0, declined = 0, non_finite = 0;
+    Tally tally(d);
+    std::array<double, kBlock> u0, u1;
+    std::array<Sample, kBlock> block;
     const std::size_t end = std::min<std::size_t>(o.samples, (c + 1) * kChunk);
-    for (std::size_t i = c * kChunk; i < end; ++i) {
-      const double u0 = uniform01(g), u1 = uniform01(g);
-      const Sample x = s.sample(u0, u1);
-      constexpr double kInf = std::numeric_limits<double>::infinity();
-      if (!x.valid) {
-        ++declined, d.t[i] = kInf, d.phi[i] = kInf;
-        continue;
-      }
-      if (!all_finite(x.direction) || !std::isfinite(x.pdf)) {
-        ++non_finite, d.t[i] = kInf, d.phi[i] = kInf;
-        continue;
-      }
-      Real t, phi;
-      cap_coordinates(s.bounding_cap, x.direction.normalized(), t, phi);
-      if (!(t <= 1 + slack)) {
-        ++outside, d.t[i] = kInf, d.phi[i] = kInf;
-        continue;
-      }
-      t = std::min<Real>(t, 1);
-      d.t[i] = double(t);
-      d.phi[i] = double(phi / kTwoPi<Real>);
-      const int ri = std::min(R - 1, int(t * R));
-      const int ai = std::min(A - 1, int(phi / kTwoPi<Real> * A));
-      ++local[std::size_t(ri) * A + ai];
+    for (std::size_t b = c * kChunk; b < end; b += kBlock) {
+      const std::size_t n = std::min(kBlock, end - b);
+      for (std::size_t j = 0; j < n; ++j) u0[j] = uniform01(g), u1[j] = uniform01(g);
+      sample_many(s, {u0.data(), n}, {u1.data(), n}, {block.data(), n});
+      tally.add(binner, {block.data(), n});
     }
     std::lock_guard lock(m);
-    for (std::size_t k = 0; k < local.size(); ++k) d.counts[k] += local[k];
-    d.outside += outside, d.declined += declined, d.non_finite += non_finite;
-    const std::size_t n = ++done;
-    if (o.progress && (n % 16 == 0 || n == chunks)) o.progress("sampling", double(n) / chunks);
+    tally.merge_into(d);
+    if (o.progress && (++done % 16 == 0 || done == chunks)) o.progress("sampling", double(done) / chunks);
   });
   return d;
 }

@@ -99,26 +99,25 @@ namespace {
 // being tested). D_nodes <= D, so the p-value from the continuous KS distribution is conservative: the
 // false-positive rate stays at most alpha, and with ~1000 nodes the loss of power is below what the sample
 // count resolves (the calibration test checks the p-values for uniformity).
-TestResult kolmogorov_smirnov(const SamplerUnderTest& s, std::string name, std::vector<double> values,
-                              const std::vector<Real>& x, const std::vector<Real>& F) {
+// slabs[k]: the samples whose coordinate has slab k (SlabLocator), so that their running sum at node k is the number
+// of values <= x[k], and at the last node every finite value; n counts every sample.
+TestResult kolmogorov_smirnov(const SamplerUnderTest& s, std::string name, const std::vector<std::uint64_t>& slabs,
+                              std::uint64_t n, const std::vector<Real>& x, const std::vector<Real>& F) {
   TestResult r = make_result(s, std::move(name));
-  std::sort(values.begin(), values.end());
-  const double n = double(values.size());
+  const double nd = double(n);
   double D = 0;
-  std::size_t i = 0;  // number of values <= x[k]
+  std::uint64_t i = 0;  // number of values <= x[k]
   for (std::size_t k = 0; k < x.size(); ++k) {
-    const double xk = k + 1 == x.size() ? std::numeric_limits<double>::max() : double(x[k]);
-    while (i < values.size() && values[i] <= xk) ++i;
+    i += slabs[k];
     // At the last node the empirical CDF counts every finite sample; samples beyond (outside the cap,
     // declined) leave it below 1.
-    D = std::max(D, std::abs(double(F[k]) - double(i) / n));
+    D = std::max(D, std::abs(double(F[k]) - double(i) / nd));
   }
   r.statistic = D;
-  boost::math::kolmogorov_smirnov_distribution<double> dist(n);
+  boost::math::kolmogorov_smirnov_distribution<double> dist(nd);
   r.p_value = boost::math::cdf(boost::math::complement(dist, D));
   std::ostringstream detail;
-  detail << "n " << values.size() << ", D at " << x.size() << " nodes of the CDF from quadrature, mass "
-         << double(F.back());
+  detail << "n " << n << ", D at " << x.size() << " nodes of the CDF from quadrature, mass " << double(F.back());
   r.detail = detail.str();
   return r;
 }
@@ -168,9 +167,9 @@ KsCdfs reference_ks_cdfs(const SamplerUnderTest& s, const BatteryOptions& o) {
   return {std::move(xr), std::move(Fr), std::move(xa), std::move(Fa)};
 }
 
-void ks_tests(const SamplerUnderTest& s, const KsCdfs& c, Draws& d, std::vector<TestResult>& out) {
-  out.push_back(kolmogorov_smirnov(s, "ks-radial", std::move(d.t), c.xr, c.Fr));
-  out.push_back(kolmogorov_smirnov(s, "ks-azimuth", std::move(d.phi), c.xa, c.Fa));
+void ks_tests(const SamplerUnderTest& s, const KsCdfs& c, const Draws& d, std::vector<TestResult>& out) {
+  out.push_back(kolmogorov_smirnov(s, "ks-radial", d.radial_slabs, d.n, c.xr, c.Fr));
+  out.push_back(kolmogorov_smirnov(s, "ks-azimuth", d.azimuth_slabs, d.n, c.xa, c.Fa));
 }
 
 }  // namespace warpcheck::validation::battery

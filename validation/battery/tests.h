@@ -39,10 +39,10 @@ Real chi_square_shift_budget(int bins);
 Real ks_cdf_tolerance(std::uint64_t n);
 
 // The pdf's integrals the statistical tests compare with: the mass of each chi-square bin (row-major
-// [radial][azimuth]) and the KS CDFs, by the grid quadrature (cap_grid.h) when the difference of its two orders
-// of integration, taken as its error, is within the bounds above and the pdf integral's tolerance / 10, else by
-// reference_bin_masses and
-// reference_ks_cdfs (or by those alone with options.reference_quadrature).
+// [radial][azimuth]) and the KS CDFs. By the grid quadrature (cap_grid.h) when the difference of its two orders of
+// integration, taken as its error, is within the bounds above and leaves the pdf-integral test's decision alone
+// (for a float pdf, whose rounding no quadrature integrates better, the last condition alone); else by
+// reference_bin_masses and reference_ks_cdfs (or by those alone with options.reference_quadrature).
 struct Expected {
   std::vector<Real> mass;
   KsCdfs ks;
@@ -56,8 +56,8 @@ std::vector<Real> reference_bin_masses(const SamplerUnderTest& s, const BatteryO
 KsCdfs reference_ks_cdfs(const SamplerUnderTest& s, const BatteryOptions& o);
 
 TestResult chi_square(const SamplerUnderTest& s, const BatteryOptions& o, const Draws& d, const Expected& e);
-// Appends ks-radial and ks-azimuth; consumes the draws' coordinates.
-void ks_tests(const SamplerUnderTest& s, const KsCdfs& c, Draws& d, std::vector<TestResult>& out);
+// Appends ks-radial and ks-azimuth, from the draws' counts per slab between c's nodes (drawn with c.xr and c.xa).
+void ks_tests(const SamplerUnderTest& s, const KsCdfs& c, const Draws& d, std::vector<TestResult>& out);
 
 // ---- Deterministic (deterministic_tests.cpp) -----------------------------------------------------------------
 

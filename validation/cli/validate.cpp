@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <sstream>
 
@@ -86,11 +87,16 @@ const char* kValidateHelp =
     "  --threads N       worker threads (default: all cores)\n"
     "  --json FILE       also write {\"alpha\",\"correction\",\"results\":[...]}; rewritten atomically after each\n"
     "                    case with \"complete\": false, so a killed run keeps what it finished\n"
-    "  --quiet           no progress on stderr\n"
+    "  --quiet           no progress on stderr (see below)\n"
     "  --resume          with --json: keep the cases already in FILE (from a killed run with the same --samples\n"
     "                    and --seed) and run only the others; the correction is recomputed over all of them\n"
     "  --negative-controls  run the deliberately broken samplers instead of the registered kernels (each\n"
     "                    must FAIL; the exit status is then 1 when the battery works)\n"
+    "\n"
+    "Progress goes to stderr: the cases done of the total, the elapsed time and the time left, estimated as the\n"
+    "mean time of the cases done so far times the cases left (a rough guide: cases differ in cost). On a terminal\n"
+    "it is one line rewritten in place that also names the running case and its phase; otherwise one line per\n"
+    "finished case.\n"
     "\n"
     "Exit status: 0 when every test passes (documented known limitations excepted), 1 when any fails, 2 on\n"
     "bad arguments.\n";
@@ -249,6 +255,69 @@ std::vector<TestResult> run_case(const Case& c, const BatteryOptions& opt) {
   return r;
 }
 
+// "42 s", "12 min 05 s", "2 h 03 min" (tenths below 10 s).
+std::string format_duration(double secs) {
+  char buf[64];
+  if (secs < 10)
+    std::snprintf(buf, sizeof buf, "%.1f s", secs);
+  else if (secs < 60)
+    std::snprintf(buf, sizeof buf, "%.0f s", secs);
+  else if (secs < 3600)
+    std::snprintf(buf, sizeof buf, "%d min %02d s", int(secs) / 60, int(secs) % 60);
+  else
+    std::snprintf(buf, sizeof buf, "%d h %02d min", int(secs) / 3600, int(secs) % 3600 / 60);
+  return buf;
+}
+
+// Progress of a run on stderr (kValidateHelp says what it shows): on a terminal one line rewritten in place with
+// the running case and its phase, otherwise one line per finished case; nothing when quiet.
+class Progress {
+ public:
+  Progress(std::size_t total, bool quiet) : total_(total), quiet_(quiet), tty_(::isatty(2)) {}
+
+  // BatteryOptions::progress while the case `label` runs: the live line on a terminal, nothing otherwise.
+  std::function<void(const std::string&, double)> during(const std::string& label) {
+    if (quiet_ || !tty_) return {};
+    live(label + ": starting");
+    return [this, label](const std::string& phase, double frac) {
+      char pct[16];
+      std::snprintf(pct, sizeof pct, " %3.0f%%", 100 * frac);
+      live(label + ": " + phase + pct);
+    };
+  }
+
+  void finished(const std::string& label, double case_secs) {
+    ++done_;
+    if (quiet_) return;
+    if (tty_) return live(label + ": done in " + format_duration(case_secs));
+    std::fprintf(stderr, "[%zu/%zu] %s done in %s; %s\n", done_, total_, label.c_str(),
+                 format_duration(case_secs).c_str(), times().c_str());
+  }
+
+  void end() const {
+    if (!quiet_ && tty_ && total_ > 0) std::fprintf(stderr, "\n");
+  }
+
+ private:
+  // "elapsed 1 min 12 s, about 3 min 10 s left", from the mean time of the cases done.
+  std::string times() const {
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    std::string t = "elapsed " + format_duration(elapsed);
+    if (done_ > 0 && done_ < total_) t += ", about " + format_duration(elapsed / done_ * (total_ - done_)) + " left";
+    return t;
+  }
+
+  // The terminal's line: cases done, times, then what runs (the rest of the line erased).
+  void live(const std::string& what) const {
+    std::fprintf(stderr, "\r[%zu/%zu done, %s] %s\x1b[K", done_, total_, times().c_str(), what.c_str());
+    std::fflush(stderr);
+  }
+
+  std::size_t total_, done_ = 0;
+  bool quiet_, tty_;
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+};
+
 void print_summary(const BatteryRun& run, std::size_t cases, double secs) {
   std::fputs(format_table(run.results).c_str(), stdout);
   std::size_t failed = 0, known = 0;
@@ -275,19 +344,14 @@ int validate_main(const std::vector<std::string>& a) {
     std::ofstream probe(v.json, std::ios::app);
     if (!probe) throw UsageError("cannot write --json file '" + v.json + "'");
   }
-  const bool tty = ::isatty(2);
   const auto start = std::chrono::steady_clock::now();
-  for (std::size_t k = 0; k < cases.size(); ++k) {
-    const Case& c = *cases[k];
-    const std::string label = "[" + std::to_string(k + 1) + "/" + std::to_string(cases.size()) + "] " + c.kernel +
-                              " / " + c.scalar + " / " + c.config;
-    if (!v.quiet) {
-      v.opt.progress = [&](const std::string& phase, double frac) {
-        if (tty) std::fprintf(stderr, "\r%s: %s %3.0f%%   ", label.c_str(), phase.c_str(), 100 * frac);
-      };
-      std::fprintf(stderr, tty ? "\r%s   " : "%s\n", label.c_str());
-    }
-    const std::vector<TestResult> r = run_case(c, v.opt);
+  Progress progress(cases.size(), v.quiet);
+  for (const Case* c : cases) {
+    const std::string label = c->kernel + " / " + c->scalar + " / " + c->config;
+    v.opt.progress = progress.during(label);
+    const auto case_start = std::chrono::steady_clock::now();
+    const std::vector<TestResult> r = run_case(*c, v.opt);
+    progress.finished(label, std::chrono::duration<double>(std::chrono::steady_clock::now() - case_start).count());
     run.results.insert(run.results.end(), r.begin(), r.end());
     if (!v.json.empty()) {  // so far, judged together, and marked incomplete: a killed run keeps what it finished
       BatteryRun partial = run;
@@ -296,7 +360,7 @@ int validate_main(const std::vector<std::string>& a) {
       write_file_atomically(v.json, to_json(partial));
     }
   }
-  if (!v.quiet && tty) std::fprintf(stderr, "\n");
+  progress.end();
   apply_correction(run.results, run.alpha, run.correction);
   run.complete = true;
   print_summary(run, cases.size(), std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());

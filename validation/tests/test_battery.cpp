@@ -11,8 +11,10 @@
 
 #include <Eigen/LU>
 
+#include "battery/drawing.h"
 #include "tests/quadrature_fixtures.h"
 #include "warpcheck/validation/battery.h"
+#include "warpcheck/validation/registry.h"
 
 namespace warpcheck::validation {
 namespace {
@@ -268,6 +270,51 @@ TEST(Battery, RejectsMalformedSamplersWithAClearError) {
   BatteryOptions o;
   o.samples = 10;
   EXPECT_THROW(run_battery(uniform_cone(), o), std::invalid_argument);
+}
+
+SamplerUnderTest registered(const std::string& kernel, const std::string& scalar, const std::string& config) {
+  const Registry reg = default_registry();
+  for (const Case& c : reg.cases())
+    if (c.kernel == kernel && c.scalar == scalar && c.config == config) return c.make();
+  throw std::runtime_error("no case " + kernel + " / " + scalar + " / " + config);
+}
+
+std::string invalid_argument_of(const SamplerUnderTest& s) {
+  BatteryOptions o;
+  o.samples = 1000;
+  try {
+    run_battery(s, o);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// A bound kernel whose pdf (or sample) is replaced keeps bind_kernel's block form of the old one: the battery
+// refuses it, naming the block form, instead of testing the old kernel.
+TEST(Battery, RefusesABlockFormThatDisagreesWithTheReplacedSingleForm) {
+  SamplerUnderTest s = registered("sphere-solid-angle", "double", "near");
+  ASSERT_TRUE(s.sample_block && s.pdf_block);
+  const auto pdf = s.pdf;
+  s.pdf = [pdf](const Vec3L& w) { return 1.01L * pdf(w); };
+  EXPECT_NE(invalid_argument_of(s).find("pdf_block disagrees with pdf"), std::string::npos) << invalid_argument_of(s);
+  s.pdf_block = nullptr;  // cleared: the battery falls back to the (replaced) single form
+  EXPECT_NO_THROW(battery::check_block_forms(s));
+
+  s = registered("sphere-solid-angle", "double", "near");
+  const auto sample = s.sample;
+  s.sample = [sample](double u0, double u1) { return sample(u1, u0); };
+  EXPECT_NE(invalid_argument_of(s).find("sample_block disagrees with sample"), std::string::npos)
+      << invalid_argument_of(s);
+}
+
+TEST(Battery, EveryRegisteredCasesBlockFormsAgreeWithItsSingleForms) {
+  const Registry reg = default_registry();
+  for (const Case& c : reg.cases()) {
+    const SamplerUnderTest s = c.make();
+    EXPECT_TRUE(s.sample_block && s.pdf_block) << c.kernel << " / " << c.scalar << " / " << c.config;
+    EXPECT_NO_THROW(battery::check_block_forms(s)) << c.kernel << " / " << c.scalar << " / " << c.config;
+  }
 }
 
 }  // namespace

@@ -1,6 +1,6 @@
-// Specification of `warpcheck validate --json FILE --resume` as a process: a run killed with SIGKILL keeps the
+// Specification of `warpcheck validate` as a process: with --json FILE --resume, a run killed with SIGKILL keeps the
 // cases it finished in FILE, bit for bit, and the same command with --resume runs only the others; a file from
-// other --samples is refused.
+// other --samples is refused. Its progress on stderr when stderr is not a terminal.
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
@@ -13,6 +13,8 @@
 #include <fstream>
 #include <iterator>
 #include <optional>
+#include <regex>
+#include <sstream>
 #include <thread>
 
 #include "warpcheck/validation/results.h"
@@ -124,5 +126,36 @@ TEST(ValidateCli, AKilledRunResumedWithTheSameCommandKeepsWhatItFinishedAndRunsO
   EXPECT_EQ(exit_status(start(other, dir, "refused")), 2);
   EXPECT_NE(read_all(dir / "refused.err").find("--samples 2000"), std::string::npos) << read_all(dir / "refused.err");
   EXPECT_EQ(read_all(json), before);
+  fs::remove_all(dir);
+}
+
+// Progress on stderr when it is not a terminal: one line per finished case, in order, with the cases done of the
+// total, the elapsed time and (but after the last case) the time left; nothing with --quiet. The below-horizon
+// cases have no sample and no quadrature: three cases in well under a second.
+TEST(ValidateCli, ProgressIsOneLinePerFinishedCaseWithTheTimeLeftAndNothingWhenQuiet) {
+  ASSERT_TRUE(fs::exists(warpcheck_cli())) << "build the warpcheck executable";
+  const fs::path dir = fs::temp_directory_path() / ("warpcheck-progress-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::vector<std::string> command = {"validate",  "--kernel", "sphere-solid-angle", "--config", "below-horizon",
+                                            "--samples", "1000"};
+  ASSERT_EQ(exit_status(start(command, dir, "plain")), 0) << read_all(dir / "plain.err");
+  const std::string err = read_all(dir / "plain.err");
+  const std::regex line(R"(\[([123])/3\] sphere-solid-angle / (float|double|long double) / below-horizon done in )"
+                        R"([0-9.]+ (s|min [0-9]+ s); elapsed [^,]+ s(, about .* left)?)");
+  std::istringstream lines(err);
+  std::string l;
+  int k = 0;
+  while (std::getline(lines, l)) {
+    std::smatch m;
+    ASSERT_TRUE(std::regex_match(l, m, line)) << l;
+    EXPECT_EQ(m[1].str(), std::to_string(++k));
+    EXPECT_EQ(m[4].matched, k < 3) << l;  // the time left, but after the last case
+  }
+  EXPECT_EQ(k, 3) << err;
+  std::vector<std::string> quiet = command;
+  quiet.push_back("--quiet");
+  ASSERT_EQ(exit_status(start(quiet, dir, "quiet")), 0);
+  EXPECT_EQ(read_all(dir / "quiet.err"), "");
   fs::remove_all(dir);
 }
