@@ -40,8 +40,8 @@ Real ks_cdf_tolerance(std::uint64_t n);
 
 // The pdf's integrals the statistical tests compare with: the mass of each chi-square bin (row-major
 // [radial][azimuth]) and the KS CDFs. By the grid quadrature (cap_grid.h) when the difference of its two orders of
-// integration, taken as its error, is within the bounds above and leaves the pdf-integral test's decision alone
-// (for a float pdf, whose rounding no quadrature integrates better, the last condition alone); else by
+// integration, taken as its error, is within the bounds above and leaves the pdf-integral test's decision alone,
+// or for a float pdf, whose rounding no quadrature integrates better (the details then state the difference); else by
 // reference_bin_masses and reference_ks_cdfs (or by those alone with options.reference_quadrature).
 struct Expected {
   std::vector<Real> mass;
