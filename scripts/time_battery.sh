@@ -72,7 +72,7 @@ run_cases() {
     esac
   done
   shift $((OPTIND - 1))
-  printf "$HEADER"
+  printf '%b' "$HEADER"
   local k s c walls cpus w i
   while IFS=$'\t' read -r k s c; do
     [[ -z "$k" || "$k" == \#* ]] && continue
@@ -90,9 +90,10 @@ run_cases() {
   done <"$1"
 }
 
-# CPU seconds (user + system) of this shell's children reaped so far (bash's `times`, second line).
+# CPU seconds (user + system) of the children this shell has reaped, from the file that bash's `times` wrote (its
+# second line). `times` must run in this shell: in a command substitution it counts the subshell's children.
 children_cpu() {
-  times | awk 'NR == 2 { for (i = 1; i <= 2; ++i) { split($i, p, "m"); c += p[1] * 60 + p[2] } print c }'
+  awk 'NR == 2 { for (i = 1; i <= 2; ++i) { split($i, p, "m"); c += p[1] * 60 + p[2] } print c }' "$1"
 }
 
 run_validate() {
@@ -102,32 +103,36 @@ run_validate() {
   fi
   local prefix=$1
   shift
-  local fifo pid status=0 tck line st cpu0 cpu1
+  local fifo pid status=0 tck line st cpu cpu0 cpu1
   tck=$(getconf CLK_TCK)
   fifo=$(mktemp -u)
   mkfifo "$fifo"
-  cpu0=$(children_cpu)
+  times >"$prefix.times"
+  cpu0=$(children_cpu "$prefix.times")
   "$CLI" validate "$@" 2>"$fifo" >"$prefix.stdout" &
   pid=$!
   # Each stderr line with the wall clock and the process's CPU seconds so far (user + system, /proc/PID/stat).
   while IFS= read -r line; do
-    st=(0 0 0 0 0 0 0 0 0 0 0 0 0 0 0)
-    read -r -a st <"/proc/$pid/stat" 2>/dev/null || true
-    printf '%s\t%s\t%s\n' "$EPOCHREALTIME" "$(((st[13] + st[14]) * 1000 / tck))" "$line"
+    cpu=-1  # the process has ended: its CPU is known only at its end
+    if read -r -a st 2>/dev/null <"/proc/$pid/stat"; then cpu=$(((st[13] + st[14]) * 1000 / tck)); fi
+    printf '%s\t%s\t%s\n' "$EPOCHREALTIME" "$cpu" "$line"
   done <"$fifo" >"$prefix.stderr"
   wait "$pid" || status=$?
   local t_end=$EPOCHREALTIME
-  cpu1=$(children_cpu)
+  times >"$prefix.times"
+  cpu1=$(children_cpu "$prefix.times")
+  rm -f "$prefix.times"
   rm -f "$fifo"
   # The case label: "[k/n] KERNEL / SCALAR / CONFIG"; the first stamped line of case k starts it, the next case's
   # (or the process's end, its CPU from the shell's reaped children) ends it.
   awk -F'\t' -v t_end="$t_end" -v last_cpu="$(awk -v a="$cpu0" -v b="$cpu1" 'BEGIN { print 1000 * (b - a) }')" \
     -v header="$HEADER" "$FAMILY_AWK"'
-    BEGIN { printf header }
+    BEGIN { printf "%s", header }
     match($3, /\[[0-9]+\/[0-9]+\] [^ ]+ \/ (long double|[^ ]+) \/ [^ ]+/) {
       label = substr($3, RSTART, RLENGTH); split(label, a, "] "); k = substr(a[1], 2) + 0
       if (k in start) next
-      split(a[2], f, " / "); start[k] = $1; cpu[k] = $2; kern[k] = f[1]; scal[k] = f[2]; conf[k] = f[3]
+      split(a[2], f, " / "); start[k] = $1; cpu[k] = $2 < 0 ? last_cpu : $2; kern[k] = f[1]; scal[k] = f[2]
+      conf[k] = f[3]
       if (k > last) last = k
     }
     END {
@@ -163,7 +168,8 @@ summarize() {
       for (i = 1; i <= n; ++i) {
         f = order[i]; if (!cnt[f]) continue
         ew = ec = 0
-        if (f != "all") { ew = reg[f] * sum[7, f] / cnt[f]; ec = reg[f] * sum[8, f] / cnt[f] }
+        if (!(f in reg)) ew = ec = 0
+        else if (f != "all") { ew = reg[f] * sum[7, f] / cnt[f]; ec = reg[f] * sum[8, f] / cnt[f] }
         else for (g in reg) if (g != "all" && cnt[g]) { ew += reg[g] * sum[7, g] / cnt[g]; ec += reg[g] * sum[8, g] / cnt[g] }
         printf "%-14s %5d %11.2f %10.2f %11.2f %10.2f %8s %12s %11s\n", f, cnt[f], median(f, 7), median(f, 8),
                sum[7, f] / cnt[f], sum[8, f] / cnt[f], (f in reg) ? reg[f] : "-",
