@@ -4,8 +4,8 @@
 #   scripts/bench_battery.sh [OUT.json] [extra benchmark args, e.g. --benchmark_filter=per_sample]
 #   BUILD=build-bench scripts/bench_battery.sh data/bench/battery/after.json
 # OUT.json defaults to data/bench/battery/battery.json (a folder of its own: data/bench/*.json are the kernel
-# benchmarks, whose names the catalogue test checks). Builds warpcheck_bench_battery with one job. Every battery call runs
-# on one thread and is timed by its CPU clock; the JSON's context records the build type, flags and load.
+# benchmarks, whose names the catalogue test checks). Builds warpcheck_bench_battery with one job. Every battery
+# call runs on one thread and is timed by its CPU clock; the JSON's context records the build type, flags and load.
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD_DIR="$ROOT/${BUILD:-build}"
