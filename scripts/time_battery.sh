@@ -17,7 +17,7 @@
 #       (the per-case table of `cases`: wall, and CPU from /proc/PID/stat at the same lines) and prints the
 #       per-family summary.
 #   scripts/time_battery.sh summary OUT.tsv [CLI]
-#       Per family: the cases measured, the median and mean of their wall and CPU, and (with CLI, for the
+#       Per family: the cases measured, the median, mean and sum of their wall and CPU, and (with CLI, for the
 #       registry's case count per family) the family's estimated total: registry cases x mean (wall, CPU).
 # CLI defaults to build/warpcheck. The machine is shared: take the smallest of a few repeats per case, and medians
 # over cases; state the load (uptime) beside the numbers.
@@ -162,8 +162,8 @@ summarize() {
     NR > 1 { add($1); add("all") }
     END {
       split(counts, c, ","); for (i in c) if (c[i] != "") { split(c[i], kv, "="); reg[kv[1]] = kv[2]; reg["all"] += kv[2] }
-      printf "%-14s %5s %11s %10s %11s %10s %8s %12s %11s\n", "family", "cases", "median_wall", "median_cpu",
-             "mean_wall", "mean_cpu", "registry", "est_wall_s", "est_cpu_s"
+      printf "%-14s %5s %11s %10s %11s %10s %10s %9s %8s %12s %11s\n", "family", "cases", "median_wall", "median_cpu",
+             "mean_wall", "mean_cpu", "sum_wall", "sum_cpu", "registry", "est_wall_s", "est_cpu_s"
       n = split("sphere polygon projected-cap sptd ltc other all", order, " ")
       for (i = 1; i <= n; ++i) {
         f = order[i]; if (!cnt[f]) continue
@@ -171,8 +171,8 @@ summarize() {
         if (!(f in reg)) ew = ec = 0
         else if (f != "all") { ew = reg[f] * sum[7, f] / cnt[f]; ec = reg[f] * sum[8, f] / cnt[f] }
         else for (g in reg) if (g != "all" && cnt[g]) { ew += reg[g] * sum[7, g] / cnt[g]; ec += reg[g] * sum[8, g] / cnt[g] }
-        printf "%-14s %5d %11.2f %10.2f %11.2f %10.2f %8s %12s %11s\n", f, cnt[f], median(f, 7), median(f, 8),
-               sum[7, f] / cnt[f], sum[8, f] / cnt[f], (f in reg) ? reg[f] : "-",
+        printf "%-14s %5d %11.2f %10.2f %11.2f %10.2f %10.1f %9.1f %8s %12s %11s\n", f, cnt[f], median(f, 7),
+               median(f, 8), sum[7, f] / cnt[f], sum[8, f] / cnt[f], sum[7, f], sum[8, f], (f in reg) ? reg[f] : "-",
                (f in reg) ? sprintf("%.0f", ew) : "-", (f in reg) ? sprintf("%.0f", ec) : "-"
       }
     }' "$1"
