@@ -15,7 +15,8 @@ using namespace warpcheck::validation::battery;
 namespace {
 std::vector<std::string> case_names() {
   std::vector<std::string> v;
-  for (const Case& c : default_registry().cases()) v.push_back(c.kernel + "/" + c.scalar + "/" + c.config);
+  const Registry reg = default_registry();
+  for (const Case& c : reg.cases()) v.push_back(c.kernel + "/" + c.scalar + "/" + c.config);
   return v;
 }
 std::string gtest_name(const testing::TestParamInfo<std::string>& i) {
@@ -50,19 +51,23 @@ TEST_P(EveryCaseQuadrature, ExpectedCountsAndCdfsMeetTheirBoundsAgainstTheAdapti
   std::vector<Real> expected(mass.size()), error(mass.size());
   for (std::size_t k = 0; k < mass.size(); ++k) expected[k] = n * mass[k], error[k] = n * (e.mass[k] - mass[k]);
   const Real shift = chi_square_shift(expected, error, Real(o.min_expected));
-  if (!float_rounding) EXPECT_LE(shift, chi_square_shift_budget(o.radial_bins * o.azimuth_bins)) << e.quadrature;
+  if (!float_rounding) {
+    EXPECT_LE(shift, chi_square_shift_budget(o.radial_bins * o.azimuth_bins)) << e.quadrature;
+  }
   Real ks_gap = 0;
   for (std::size_t k = 0; k < ks.Fr.size(); ++k)
     ks_gap = std::max({ks_gap, std::abs(e.ks.Fr[k] - ks.Fr[k]), std::abs(e.ks.Fa[k] - ks.Fa[k])});
-  if (!float_rounding) EXPECT_LE(ks_gap, ks_cdf_tolerance(o.samples)) << e.quadrature;
+  if (!float_rounding) {
+    EXPECT_LE(ks_gap, ks_cdf_tolerance(o.samples)) << e.quadrature;
+  }
   const Real total = std::accumulate(e.mass.begin(), e.mass.end(), Real(0));
   const Real reference = std::accumulate(mass.begin(), mass.end(), Real(0));
   if (!float_rounding) {
     EXPECT_LE(std::abs(total - reference), std::max(s.tolerance, std::abs(std::abs(reference - 1) - s.tolerance)) / 10)
         << e.quadrature;
   }
-  std::printf("%s: chi-square shift %.3g, KS %.3g, total %.3g; %s\n", GetParam().c_str(), double(shift),
-              double(ks_gap), double(total - reference), e.quadrature.c_str());
+  std::printf("%s: chi-square shift %.3g, KS %.3g, total %.3g; %s\n", GetParam().c_str(), double(shift), double(ks_gap),
+              double(total - reference), e.quadrature.c_str());
 }
 
 INSTANTIATE_TEST_SUITE_P(Registry, EveryCaseQuadrature, testing::ValuesIn(case_names()), gtest_name);
