@@ -161,8 +161,8 @@ void bm_fixed_cost_parts(benchmark::State& state, CaseName c) {
 
 constexpr std::uint64_t kPerSampleCount = 1 << 20;
 
-// One seed's per-sample work: the draws (with their KS slab counts), the chi-square and the two KS tests. The expected masses
-// and the KS CDFs are uniform stand-ins: their values do not change this work, and computing them is the fixed
+// One seed's per-sample work: the draws (with their KS slab counts), the chi-square and the two KS tests. The expected
+// masses and the KS CDFs are uniform stand-ins: their values do not change this work, and computing them is the fixed
 // cost measured above. Returns the CPU seconds of the draws alone.
 double battery_seed_work(const SamplerUnderTest& s, const BatteryOptions& o) {
   using namespace battery;
