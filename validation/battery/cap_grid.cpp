@@ -417,11 +417,4 @@ CapGrid integrate_cap_grid(const SamplerUnderTest& s, const CapGridSpec& spec) {
   return g;
 }
 
-Real grid_disagreement(const CapGrid& g, Real floor) {
-  Real worst = 0;
-  for (std::size_t k = 0; k < g.bins.size(); ++k)
-    worst = std::max(worst, std::abs(g.bins[k] - g.bins_check[k]) / std::max({g.bins[k], g.bins_check[k], floor}));
-  return worst;
-}
-
 }  // namespace warpcheck::validation::battery

@@ -33,7 +33,4 @@ struct CapGrid {
 // fixed 3-point rule needs; a 1D piece whose Kronrod error estimate exceeds rel_tol is refined adaptively.
 CapGrid integrate_cap_grid(const SamplerUnderTest& s, const CapGridSpec& spec);
 
-// The largest relative disagreement of bins and bins_check, each bin's difference over max(mass, floor).
-Real grid_disagreement(const CapGrid& g, Real floor);
-
 }  // namespace warpcheck::validation::battery
