@@ -1,0 +1,71 @@
+// core.h's fused_multiply_add: the same bits as std::fma, on inputs that stress its two exact steps.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <random>
+
+#include "warpcheck/core.h"
+
+namespace warpcheck {
+namespace {
+
+using LD = long double;
+
+struct FmaInputs {
+  std::mt19937_64 rng{20261204};
+
+  // A full 64-bit significand with an exponent in [emin, emax] and a random sign.
+  LD full(int emin, int emax) {
+    const LD x = std::ldexp(LD(rng() | (1ull << 63)), -63 + emin + int(rng() % unsigned(emax - emin + 1)));
+    return (rng() & 1) ? -x : x;
+  }
+  // A 33-bit integer: products of two are exact in 66 bits, so a b + c often lands on a tie of the 64-bit grid.
+  LD short_integer() { return LD((rng() >> 31) | (1ull << 32)); }
+};
+
+int mismatches_against_std_fma(LD a, LD b, LD c) {
+  const LD expected = std::fma(a, b, c), got = fused_multiply_add(a, b, c);
+  const bool same =
+      (expected == got && std::signbit(expected) == std::signbit(got)) || (std::isnan(expected) && std::isnan(got));
+  return same ? 0 : 1;
+}
+
+TEST(FusedMultiplyAdd, LongDoubleGivesTheBitsOfStdFmaOnRandomCancellingAndTieInputs) {
+  FmaInputs in;
+  int bad = 0;
+  for (int i = 0; i < 100000; ++i) {
+    const LD a = in.full(-20, 20), b = in.full(-20, 20), p = a * b;
+    bad += mismatches_against_std_fma(a, b, in.full(-60, 60));
+    bad += mismatches_against_std_fma(a, b, -p);  // the product's rounding error, as Kahan's determinant uses
+    bad += mismatches_against_std_fma(a, b, -p * (1 + LD(int(in.rng() % 64) - 32) * 0x1p-63L));
+    bad += mismatches_against_std_fma(a, b, std::ldexp(p, -int(in.rng() % 140)));
+    const LD a2 = in.short_integer(), b2 = in.short_integer();
+    const LD c2 = std::ldexp(LD(in.rng() >> (in.rng() % 64)), int(in.rng() % 80) - 10);
+    bad += mismatches_against_std_fma(a2, b2, (in.rng() & 1) ? c2 : -c2);
+    bad += mismatches_against_std_fma(a2, b2, -std::ldexp(LD(1), int(in.rng() % 70)));
+    // a b on a tie of the grid and c far below it: one rounding of the low parts to nearest would lose c's side
+    const LD below = std::ldexp(LD(1), -63 - int(in.rng() % 60));
+    bad += mismatches_against_std_fma(a2, b2, (in.rng() & 1) ? below : -below);
+  }
+  EXPECT_EQ(bad, 0) << "of 700000 inputs";
+}
+
+TEST(FusedMultiplyAdd, LongDoubleGivesTheBitsOfStdFmaOutsideItsExactRangeAndForSpecialValues) {
+  const LD inf = std::numeric_limits<LD>::infinity(), nan = std::numeric_limits<LD>::quiet_NaN();
+  const LD tiny = std::numeric_limits<LD>::denorm_min(), huge = std::numeric_limits<LD>::max();
+  const LD values[] = {0.0L, -0.0L, 1.0L, -3.5L, 0x1p-9000L, 0x1p9000L, tiny, huge, inf, -inf, nan, 0x1.8p-16382L};
+  int bad = 0;
+  for (const LD a : values)
+    for (const LD b : values)
+      for (const LD c : values) bad += mismatches_against_std_fma(a, b, c);
+  EXPECT_EQ(bad, 0);
+}
+
+TEST(FusedMultiplyAdd, FloatAndDoubleAreStdFma) {
+  EXPECT_EQ(fused_multiply_add(0.1f, 10.0f, -1.0f), std::fma(0.1f, 10.0f, -1.0f));
+  EXPECT_EQ(fused_multiply_add(0.1, 10.0, -1.0), std::fma(0.1, 10.0, -1.0));
+}
+
+}  // namespace
+}  // namespace warpcheck
