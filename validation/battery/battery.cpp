@@ -38,19 +38,24 @@ BatteryOptions checked_options(const SamplerUnderTest& s, const BatteryOptions& 
   return o;
 }
 
-// Everything of a battery run that does not depend on the seed.
+// Everything of a battery run that does not depend on the seed. The parts that run on one thread are started
+// beside the grid quadrature and the draws, which use every thread.
 struct Prepared {
   Expected expected;
-  std::vector<TestResult> deterministic;
+  std::shared_future<Real> outside;                         // the pdf's integral outside the bounding cap
+  std::shared_future<std::vector<TestResult>> independent;  // pdf-consistency and the normalisations
 };
 
 Prepared prepare(const SamplerUnderTest& s, const BatteryOptions& o) {
   Prepared p;
+  p.outside = beside(o, [&s, o] { return outside_integral(s, o); });
+  p.independent = beside(o, [&s, o] {
+    std::vector<TestResult> r{pdf_consistency(s, o)};
+    for (TestResult& n : normalizations(s)) r.push_back(std::move(n));
+    return r;
+  });
   if (o.progress) o.progress("quadrature", 0);
   p.expected = expected_integrals(s, o);
-  p.deterministic.push_back(pdf_integral(s, o, p.expected));
-  p.deterministic.push_back(pdf_consistency(s, o));
-  for (TestResult& r : normalizations(s)) p.deterministic.push_back(std::move(r));
   return p;
 }
 
@@ -60,7 +65,9 @@ std::vector<TestResult> run_seed(const SamplerUnderTest& s, const BatteryOptions
   const Draws d = draw(s, o, p.expected.ks.xr, p.expected.ks.xa);
   out.push_back(chi_square(s, o, d, p.expected));
   ks_tests(s, p.expected.ks, d, out);
-  out.insert(out.end(), p.deterministic.begin(), p.deterministic.end());
+  out.push_back(pdf_integral(s, o, p.expected, p.outside.get()));
+  const std::vector<TestResult>& independent = p.independent.get();
+  out.insert(out.end(), independent.begin(), independent.end());
   return out;
 }
 

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <future>
 #include <optional>
 #include <random>
 #include <span>
@@ -38,6 +39,13 @@ template <class F> void parallel_for(std::size_t n, int threads, F&& body) {
   for (int k = 1; k < threads; ++k) pool.emplace_back(worker);
   worker();
   for (auto& t : pool) t.join();
+}
+
+// Work that runs on one thread (an adaptive quadrature, pdf-consistency) started beside the parallel work when
+// the run may use more than one thread, else deferred to the first get(): the same result either way, since each
+// test is a function of the sampler and the options alone.
+template <class F> auto beside(const BatteryOptions& o, F f) {
+  return std::async(thread_count(o) > 1 ? std::launch::async : std::launch::deferred, std::move(f)).share();
 }
 
 // Throws std::invalid_argument when a block form of the sampler (sample_block, pdf_block) disagrees with its

@@ -61,7 +61,9 @@ void ks_tests(const SamplerUnderTest& s, const KsCdfs& c, const Draws& d, std::v
 
 // ---- Deterministic (deterministic_tests.cpp) -----------------------------------------------------------------
 
-TestResult pdf_integral(const SamplerUnderTest& s, const BatteryOptions& o, const Expected& e);
+// The pdf's integral over the sphere outside the bounding cap (nested adaptive quadrature).
+Real outside_integral(const SamplerUnderTest& s, const BatteryOptions& o);
+TestResult pdf_integral(const SamplerUnderTest& s, const BatteryOptions& o, const Expected& e, Real outside);
 TestResult pdf_consistency(const SamplerUnderTest& s, const BatteryOptions& o);
 // One result per declared Normalization.
 std::vector<TestResult> normalizations(const SamplerUnderTest& s);

@@ -142,7 +142,7 @@ void bm_fixed_cost_parts(benchmark::State& state, CaseName c) {
     const Stopwatch t;
     const Expected e = expected_integrals(s, o);
     t_expected += t.cpu();
-    benchmark::DoNotOptimize(pdf_integral(s, o, e));
+    benchmark::DoNotOptimize(pdf_integral(s, o, e, outside_integral(s, o)));
     t_integral += t.cpu() - t_expected;
     benchmark::DoNotOptimize(pdf_consistency(s, o));
     t_consistency += t.cpu() - t_expected - t_integral;
