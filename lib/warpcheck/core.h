@@ -189,8 +189,17 @@ inline long double sum_rounded_to_odd(long double a, long double b) {
   std::uint64_t significand;
   std::memcpy(&significand, &s, sizeof significand);  // x87: bytes 0-7 hold the 64-bit significand
   if (e == 0 || (significand & 1u)) return s;
-  return std::nextafter(
-      s, e > 0 ? std::numeric_limits<long double>::infinity() : -std::numeric_limits<long double>::infinity());
+  // The neighbour towards a + b, by the significand's last bit (0 here, so +-1 neither carries nor borrows),
+  // except below a power of two, where the binade changes.
+  if ((e > 0) == (s > 0))
+    significand |= 1u;
+  else if (significand != (std::uint64_t(1) << 63))
+    significand -= 1u;
+  else
+    return std::nextafter(
+        s, e > 0 ? std::numeric_limits<long double>::infinity() : -std::numeric_limits<long double>::infinity());
+  std::memcpy(&s, &significand, sizeof significand);
+  return s;
 }
 
 // p + error == a b exactly, p = fl(a b) (Dekker 1971 with Veltkamp's split into halves of 32 bits).
@@ -201,6 +210,19 @@ inline long double exact_product_error(long double a, long double b, long double
   return al * bl - (((p - ah * bh) - al * bh) - ah * bl);
 }
 }  // namespace detail
+
+// c - a b where c = fl(a b): the product's rounding error, negated, as fused_multiply_add(-a, b, c) gives it.
+template <class T> T negated_product_error(T a, T b, T c) {
+  if constexpr (std::is_same_v<T, long double> && kX87LongDouble) {
+    constexpr long double lo = 0x1p-8000L, hi = 0x1p8000L;
+    const long double ac = std::abs(c);
+    if (ac > lo && ac < hi && std::abs(a) < hi && std::abs(b) < hi) {
+      const long double e = detail::exact_product_error(a, b, c);
+      return e == 0 ? 0.0L : -e;  // an exact zero sum is +0 when rounding to nearest
+    }
+  }
+  return std::fma(-a, b, c);
+}
 
 template <class T> T fused_multiply_add(T a, T b, T c) {
   if constexpr (std::is_same_v<T, long double> && kX87LongDouble) {
@@ -213,6 +235,66 @@ template <class T> T fused_multiply_add(T a, T b, T c) {
     }
   }
   return std::fma(a, b, c);
+}
+
+// ---- sin and cos in radians ----
+// std::sin and std::cos, except x87 long double with pi/4 < |x| < 2^12: glibc reduces every such argument by the
+// Payne-Hanek method (~250 ns a call). There x - k pi/2 is taken by Cody & Waite with pi/2 = P1 + P2 + P3: k P1 and
+// k P2 are exact (P1 and P2 hold 50 bits, k < 2^12), x - k P1 is exact (Sterbenz), and P3's truncation leaves
+// 2^-170 k; then sin or cos of |r| <= pi/4 on glibc's fast path. Within 2 ulps of a 50-digit reference like
+// sinl and cosl, not always their bits (test: SineCosine.*).
+namespace detail {
+inline long double quarter_turns(long double x, long long& k) {
+  constexpr long double two_over_pi = 0xa2f9836e4e44152ap-64L;
+  constexpr long double p1 = 0xc90fdaa22168c000p-63L, p2 = 0x8d313198a2e04000p-117L, p3 = -0x8f8cbb5bf6c7ddd6p-169L;
+  k = std::llrint(x * two_over_pi);
+  const long double kk = static_cast<long double>(k);
+  return ((x - kk * p1) - kk * p2) - kk * p3;
+}
+inline bool reduce_for_sine_cosine(long double x) {
+  const long double ax = std::abs(x);
+  return ax > 0.78539816339744830962L && ax < 0x1p12L;
+}
+}  // namespace detail
+
+template <class T> T sine(T x) {
+  if constexpr (std::is_same_v<T, long double> && kX87LongDouble) {
+    if (detail::reduce_for_sine_cosine(x)) {
+      long long k;
+      const long double r = detail::quarter_turns(x, k);
+      switch (k & 3) {
+        case 0:
+          return std::sin(r);
+        case 1:
+          return std::cos(r);
+        case 2:
+          return -std::sin(r);
+        default:
+          return -std::cos(r);
+      }
+    }
+  }
+  return std::sin(x);
+}
+
+template <class T> T cosine(T x) {
+  if constexpr (std::is_same_v<T, long double> && kX87LongDouble) {
+    if (detail::reduce_for_sine_cosine(x)) {
+      long long k;
+      const long double r = detail::quarter_turns(x, k);
+      switch (k & 3) {
+        case 0:
+          return std::cos(r);
+        case 1:
+          return -std::sin(r);
+        case 2:
+          return -std::cos(r);
+        default:
+          return std::sin(r);
+      }
+    }
+  }
+  return std::cos(x);
 }
 
 // v * 2^e, exact componentwise (std::ldexp) unless a component over- or underflows.

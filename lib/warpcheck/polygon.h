@@ -63,7 +63,7 @@ template <class T> struct PolygonLightGeometry {
 // Peters 2021 Sec. 3.7 needs for short edges.
 template <class T> T kahan_det(T a, T b, T c, T d) {
   const T w = b * c;
-  const T e = fused_multiply_add(-b, c, w);  // the rounding error of b c, exactly
+  const T e = negated_product_error(b, c, w);  // w - b c, exactly
   const T f = fused_multiply_add(a, d, -w);
   return f + e;
 }

@@ -40,7 +40,7 @@ template <class T> T cut_disk_area_from_angle(T theta) {
     }
     return sum / T(2);
   }
-  return (phi - std::sin(phi)) / T(2);
+  return (phi - sine(phi)) / T(2);
 }
 
 // The area of the unit disk left of x (pi/2 + A(x), Sec. 3.3), given x and its half-height hh = sqrt(1 - x^2).
@@ -69,7 +69,7 @@ template <class T> T solve_cut_disk_angle(T target) {
   std::uintmax_t iterations = 60;
   return boost::math::tools::newton_raphson_iterate(
       [target](T th) {
-        const T s = std::sin(th);
+        const T s = sine(th);
         return std::make_pair(cut_disk_area_from_angle(th) - target, T(2) * s * s);
       },
       guess, T(0), kPi<T> / T(2), std::numeric_limits<T>::digits - 2, iterations);
@@ -144,8 +144,8 @@ template <class T, CutDiskInverse M>
     out.half_height2 = hh2;
   } else {
     const T theta = solve_cut_disk_angle(e);  // C(theta) = e: the area beyond |x| = cos(theta)
-    out.x = positive ? std::cos(theta) : -std::cos(theta);
-    out.half_height = std::sin(theta);
+    out.x = positive ? cosine(theta) : -cosine(theta);
+    out.half_height = sine(theta);
   }
   return out;
 }

@@ -1,5 +1,8 @@
-// core.h's fused_multiply_add: the same bits as std::fma, on inputs that stress its two exact steps.
+// core.h's fused_multiply_add (the same bits as std::fma, on inputs that stress its two exact steps) and sine and
+// cosine (as accurate as std::sin and std::cos).
 #include <gtest/gtest.h>
+
+#include <boost/multiprecision/cpp_bin_float.hpp>
 
 #include <cmath>
 #include <cstdint>
@@ -51,6 +54,19 @@ TEST(FusedMultiplyAdd, LongDoubleGivesTheBitsOfStdFmaOnRandomCancellingAndTieInp
   EXPECT_EQ(bad, 0) << "of 700000 inputs";
 }
 
+TEST(FusedMultiplyAdd, NegatedProductErrorGivesTheBitsOfStdFmaOfTheRoundedProduct) {
+  FmaInputs in;
+  int bad = 0;
+  for (int i = 0; i < 100000; ++i) {
+    const LD a = in.full(-20, 20), b = in.full(-20, 20), a2 = in.short_integer(), b2 = in.short_integer();
+    for (const auto& [x, y] : {std::pair{a, b}, std::pair{a2, b2}, std::pair{a2, LD(1)}}) {
+      const LD p = x * y, expected = std::fma(-x, y, p), got = negated_product_error(x, y, p);
+      bad += !(expected == got && std::signbit(expected) == std::signbit(got));
+    }
+  }
+  EXPECT_EQ(bad, 0) << "of 300000 inputs";
+}
+
 TEST(FusedMultiplyAdd, LongDoubleGivesTheBitsOfStdFmaOutsideItsExactRangeAndForSpecialValues) {
   const LD inf = std::numeric_limits<LD>::infinity(), nan = std::numeric_limits<LD>::quiet_NaN();
   const LD tiny = std::numeric_limits<LD>::denorm_min(), huge = std::numeric_limits<LD>::max();
@@ -65,6 +81,42 @@ TEST(FusedMultiplyAdd, LongDoubleGivesTheBitsOfStdFmaOutsideItsExactRangeAndForS
 TEST(FusedMultiplyAdd, FloatAndDoubleAreStdFma) {
   EXPECT_EQ(fused_multiply_add(0.1f, 10.0f, -1.0f), std::fma(0.1f, 10.0f, -1.0f));
   EXPECT_EQ(fused_multiply_add(0.1, 10.0, -1.0), std::fma(0.1, 10.0, -1.0));
+}
+
+using Reference = boost::multiprecision::cpp_bin_float_50;
+
+// |got - exact| in units of the last place of the exact value rounded to long double.
+double ulps_from(LD got, const Reference& exact) {
+  const LD rounded = static_cast<LD>(exact);
+  const LD ulp = std::ldexp(LD(1), std::ilogb(rounded) - (std::numeric_limits<LD>::digits - 1));
+  return static_cast<double>(abs(Reference(got) - exact) / Reference(ulp));
+}
+
+TEST(SineCosine, LongDoubleIsWithinOneAndAHalfUlpsOfA50DigitReferenceAsSinlAndCoslAre) {
+  std::mt19937_64 rng(20261204);
+  const Reference half_pi = boost::math::constants::half_pi<Reference>();
+  double worst = 0, worst_std = 0;
+  auto check = [&](LD x) {
+    const Reference s = sin(Reference(x)), c = cos(Reference(x));
+    worst = std::max({worst, ulps_from(sine(x), s), ulps_from(cosine(x), c)});
+    worst_std = std::max({worst_std, ulps_from(std::sin(x), s), ulps_from(std::cos(x), c)});
+  };
+  for (int i = 0; i < 20000; ++i) {
+    // |x| in [1/2, 2^13): both sides of the reduced range's bound 2^12.
+    const LD x = std::ldexp(LD(rng() | (1ull << 63)), -64 + int(rng() % 14));
+    check((rng() & 1) ? x : -x);
+    // The long doubles nearest a multiple of pi/2, where the reduced argument cancels.
+    LD near = static_cast<LD>(half_pi * int(1 + rng() % 2600));
+    check(near), check(std::nextafter(near, LD(0))), check(std::nextafter(near, LD(1e9)));
+  }
+  EXPECT_LE(worst, 1.5) << "glibc's sinl and cosl: " << worst_std << " ulps";
+}
+
+TEST(SineCosine, FloatAndDoubleAreStdSinAndCos) {
+  for (const double x : {0.3, 1.0, 2.5, -7.0, 1e5}) {
+    EXPECT_EQ(sine(x), std::sin(x));
+    EXPECT_EQ(cosine(float(x)), std::cos(float(x)));
+  }
 }
 
 }  // namespace
