@@ -189,26 +189,24 @@ void place_nodes(Slab& sl, bool edge_singular) {
 }
 
 // Whether a slab's three values bend more than a 3-point rule resolves: the second difference of any component
-// beyond 1e-2 of that component (or of 1e-3 of the total, for the small ones). A smooth integrand varying on a
-// scale s has a relative second difference d of about 0.15 (h / s)^2 and the rule a relative error of about
-// (h / s)^6 / 2e6 = (d / 0.15)^3 / 2e6: 1.5e-10 at the threshold.
-bool bends(const Slab& sl) {
+// beyond `threshold` (CapGridSpec::bend, 1e-2) of that component (or of 1e-3 of the total, for the small ones). A
+// smooth integrand varying on a scale s has a relative second difference d of about 0.15 (h / s)^2 and the rule a
+// relative error of about (h / s)^6 / 2e6 = (d / 0.15)^3 / 2e6: 1.5e-10 at the threshold.
+bool bends(const Slab& sl, Real threshold) {
   const std::vector<Real>&l = sl.value[0], &c = sl.value[1], &r = sl.value[2];
   Real total = 0;
   for (Real v : c) total += std::abs(v);
   for (std::size_t j = 0; j < c.size(); ++j)
-    if (std::abs(l[j] - 2 * c[j] + r[j]) > Real(1e-2) * std::max(std::abs(c[j]), Real(1e-3) * total) &&
-        std::abs(l[j] - 2 * c[j] + r[j]) > 0)
-      return true;
+    if (std::abs(l[j] - 2 * c[j] + r[j]) > threshold * std::max(std::abs(c[j]), Real(1e-3) * total)) return true;
   return false;
 }
 
 // Integrates the slabs (eval(x, values, calls) gives the vector of one line or ring), halving a slab that bends
-// (up to 8 times, to 1/256 of its width, and not below `resolution`), and returns the leaf slabs in order.
+// (up to max_depth times, 8: to 1/256 of its width, and not below `resolution`), and returns the leaf slabs in
+// order.
 template <class Eval>
 std::vector<Slab> integrate_slabs(std::vector<Slab> todo, bool edge_singular, const CapGridSpec& sp, const Eval& eval) {
   const int threads = sp.threads;
-  constexpr int kMaxDepth = 8;
   std::vector<Slab> done;
   while (!todo.empty()) {
     for (Slab& sl : todo) place_nodes(sl, edge_singular);
@@ -220,7 +218,7 @@ std::vector<Slab> integrate_slabs(std::vector<Slab> todo, bool edge_singular, co
     });
     std::vector<Slab> next;
     for (Slab& sl : todo) {
-      if (sl.depth < kMaxDepth && sl.b - sl.a > 2 * sp.resolution && bends(sl)) {
+      if (sl.depth < sp.max_depth && sl.b - sl.a > 2 * sp.resolution && bends(sl, sp.bend)) {
         const Real mid = (sl.a + sl.b) / 2;
         done.push_back(Slab{sl.a, sl.b, false, -1, {}, {}, {}, sl.calls});  // keeps the count of calls only
         next.push_back(Slab{sl.a, mid, sl.cubic, sl.depth + 1, {}, {}, {}, 0});

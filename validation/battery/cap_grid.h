@@ -15,6 +15,8 @@ struct CapGridSpec {
   Real rel_tol = 1e-8L;                     // relative tolerance of each 1D piece's Gauss-Kronrod rule
   Real resolution = 0;                      // slabs are not halved below this width in t or phi (the sampler's
                                             // scalar cannot tell directions closer than that apart)
+  Real bend = 1e-2L;                        // a slab is halved where its second difference exceeds this
+  int max_depth = 8;                        // ... up to this many times
   int threads = 1;
 };
 

@@ -139,8 +139,9 @@ template <CutDiskInverse M> std::vector<std::pair<Real, Real>> projected_cap_ban
 //   m1     = E[X]                     (equals the integral of cos over the sampler's support if pdf is its density)
 //   m1_in  = E[X 1(w in the light)]   (what a renderer computes: a ray outside the cap misses the light)
 //   m2     = E[X^2]
+// (m1 alone with mean_only.)
 template <class T, CutDiskInverse M>
-LambertianMoments projected_cap_lambertian_moments(const SphereLightGeometry<Real>& g, Real tol) {
+LambertianMoments projected_cap_lambertian_moments(const SphereLightGeometry<Real>& g, Real tol, bool mean_only) {
   // min_complement 1e-18: no abscissa closer than that to an end of [0, 1]. Boost's default (4 * min of long
   // double) puts u0 within ~1e-4900 of a piece's end, where it rounds onto the end itself (a sample on the
   // silhouette, declined, or on the next piece); for the exact inverse in long double on tiny-straddling that
@@ -158,7 +159,7 @@ LambertianMoments projected_cap_lambertian_moments(const SphereLightGeometry<Rea
   std::vector<Real> cuts;
   for (const auto& [a, b] : projected_cap_bands<M>(g)) cuts.push_back(a), cuts.push_back(b);
   LambertianMoments out;
-  for (int what = 0; what < 3; ++what) {
+  for (int what = 0; what < (mean_only ? 1 : 3); ++what) {
     Real total = 0;
     for (int i = 0; i < count; ++i) {
       std::vector<Real> edges{Real(ps[i].u_lo), Real(ps[i].u_hi)};
@@ -188,6 +189,10 @@ LambertianMoments projected_cap_lambertian_moments(const SphereLightGeometry<Rea
 
 namespace {
 
+// The moments' quadrature tolerance: 1e-10, or float's epsilon, below which a float sampler's rounding makes
+// tanh-sinh refine to its last level without converging (still 30 times below float's tolerances, 4e-6 and up).
+template <class T> Real moments_tolerance() { return std::max<Real>(1e-10L, std::numeric_limits<T>::epsilon()); }
+
 template <template <class> class K, class T> Case make_case(const ProjectedCapConfig& c) {
   constexpr CutDiskInverse M = K<T>::inverse;
   const char* kernel = K<T>::name;
@@ -211,7 +216,7 @@ template <template <class> class K, class T> Case make_case(const ProjectedCapCo
     }
     Normalization mean;
     mean.what = "mean Lambertian estimate E[cos/pdf] (primary-space quadrature) vs projected solid angle";
-    mean.kernel = [g = c.g] { return projected_cap_lambertian_moments<T, M>(g, 1e-10L).m1; };
+    mean.kernel = [g = c.g] { return projected_cap_lambertian_moments<T, M>(g, moments_tolerance<T>(), true).m1; };
     mean.reference = reference;
     s.normalizations.push_back(mean);
     if constexpr (std::is_same_v<T, float>) {
@@ -227,7 +232,7 @@ template <template <class> class K, class T> Case make_case(const ProjectedCapCo
     const SphereView<Real> sv = make_sphere_view(c.g);
     if (!sv.valid()) return out;
     const Real phi = reference_projected_solid_angle(c.g);
-    const LambertianMoments m = projected_cap_lambertian_moments<T, M>(c.g, 1e-10L);
+    const LambertianMoments m = projected_cap_lambertian_moments<T, M>(c.g, moments_tolerance<T>());
     // Solid-angle sampling: the estimate is Omega max(0, cos): E = Phi, E[X^2] = Omega * integral of cos_+^2.
     const Real omega = kTwoPi<Real> * sv.one_minus_cos_max;
     const Real cos2 = cap_cosine_moment(c.g, 2);
@@ -271,17 +276,17 @@ template <template <class> class K, class T> Case make_case(const ProjectedCapCo
 }  // namespace
 
 template LambertianMoments projected_cap_lambertian_moments<float, CutDiskInverse::kQuintic>(
-    const SphereLightGeometry<Real>&, Real);
+    const SphereLightGeometry<Real>&, Real, bool);
 template LambertianMoments projected_cap_lambertian_moments<double, CutDiskInverse::kQuintic>(
-    const SphereLightGeometry<Real>&, Real);
+    const SphereLightGeometry<Real>&, Real, bool);
 template LambertianMoments projected_cap_lambertian_moments<Real, CutDiskInverse::kQuintic>(
-    const SphereLightGeometry<Real>&, Real);
+    const SphereLightGeometry<Real>&, Real, bool);
 template LambertianMoments projected_cap_lambertian_moments<float, CutDiskInverse::kExact>(
-    const SphereLightGeometry<Real>&, Real);
+    const SphereLightGeometry<Real>&, Real, bool);
 template LambertianMoments projected_cap_lambertian_moments<double, CutDiskInverse::kExact>(
-    const SphereLightGeometry<Real>&, Real);
+    const SphereLightGeometry<Real>&, Real, bool);
 template LambertianMoments projected_cap_lambertian_moments<Real, CutDiskInverse::kExact>(
-    const SphereLightGeometry<Real>&, Real);
+    const SphereLightGeometry<Real>&, Real, bool);
 template std::vector<std::pair<Real, Real>> projected_cap_bands<CutDiskInverse::kQuintic>(
     const SphereLightGeometry<Real>&);
 template std::vector<std::pair<Real, Real>> projected_cap_bands<CutDiskInverse::kExact>(

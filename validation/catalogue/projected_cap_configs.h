@@ -38,7 +38,8 @@ struct LambertianMoments {
   Real m1 = 0, m1_in = 0, m2 = 0;
 };
 template <class T, CutDiskInverse M>
-LambertianMoments projected_cap_lambertian_moments(const SphereLightGeometry<Real>& g, Real tol = 1e-10L);
+LambertianMoments projected_cap_lambertian_moments(const SphereLightGeometry<Real>& g, Real tol = 1e-10L,
+                                                   bool mean_only = false);
 
 // float's tolerance for a configuration: twice its measured float error (the largest deterministic battery
 // statistic of the float kernels, see projected_cap.cpp), rounded up to one digit, at least 1e-6.
