@@ -119,7 +119,7 @@ void line_crossings(const std::vector<Vec3L>& m, Real omc, Real c, Real s, std::
   for (const Vec3L& p : m) {
     Real theta = std::atan2(-p.z(), p.x() * c + p.y() * s);
     if (theta < 0) theta += kPi<Real>;
-    const Real sh = std::sin(theta / 2), x = 2 * sh * sh / omc;
+    const Real sh = sine(theta / 2), x = 2 * sh * sh / omc;
     if (x > 0 && x < 1) t.push_back(x);
   }
 }
@@ -271,7 +271,7 @@ void integrate_lines(const SamplerUnderTest& s, const CapGridSpec& sp, const Cap
     }
   auto line_at = [&](Real phi, std::vector<Real>& line, long& calls) {
     line.assign(std::size_t(R), 0);
-    const Real c = std::cos(phi), sn = std::sin(phi);
+    const Real c = cosine(phi), sn = sine(phi);
     const Vec3L u = cf.fr.to_world(Vec3L(c, sn, 0)), axis = cf.fr.to_world(Vec3L(0, 0, 1));
     std::vector<Real> t_edges;
     for (int j = 0; j <= R; ++j) t_edges.push_back(Real(j) / R);
@@ -333,12 +333,12 @@ void integrate_rings(const SamplerUnderTest& s, const CapGridSpec& sp, const Cap
   for (const Vec3L& p : m) {  // tangency of the plane's great circle with the rings: tan(theta) = |m_z| / rho
     const Real theta = std::atan2(std::abs(p.z()), std::hypot(p.x(), p.y()));
     for (Real th : {theta, kPi<Real> - theta}) {
-      const Real sh = std::sin(th / 2);
+      const Real sh = sine(th / 2);
       tangencies.push_back(2 * sh * sh / cf.omc);
     }
   }
   for (int c = 0; c < A; ++c)  // where the boundary crosses a column's edge, a column's integrand kinks
-    line_crossings(m, cf.omc, std::cos(kTwoPi<Real> * c / A), std::sin(kTwoPi<Real> * c / A), cuts);
+    line_crossings(m, cf.omc, cosine(kTwoPi<Real> * c / A), sine(kTwoPi<Real> * c / A), cuts);
   t_edges.insert(t_edges.end(), cuts.begin(), cuts.end());
   t_edges.insert(t_edges.end(), tangencies.begin(), tangencies.end());
   const std::vector<Real> e = edges_of(t_edges, 0, 1);
@@ -349,7 +349,7 @@ void integrate_rings(const SamplerUnderTest& s, const CapGridSpec& sp, const Cap
   for (int c = 0; c < A; ++c)
     for (int i = 0; i < 15; ++i) {
       const Real a = phi_edges_whole[c], phi = a + (phi_edges_whole[c + 1] - a) * kRule15.v[i];
-      table[std::size_t(c) * 15 + i] = {std::cos(phi), std::sin(phi)};
+      table[std::size_t(c) * 15 + i] = {cosine(phi), sine(phi)};
     }
   const Vec3L ex = cf.fr.to_world(Vec3L(1, 0, 0)), ey = cf.fr.to_world(Vec3L(0, 1, 0));
   auto ring_at = [&](Real t, std::vector<Real>& ring, long& calls) {
@@ -369,7 +369,7 @@ void integrate_rings(const SamplerUnderTest& s, const CapGridSpec& sp, const Cap
     auto direction = [&](const Piece& p, Real v, Real& jac) {
       jac = p.b - p.a;
       const Real phi = p.a + (p.b - p.a) * v;
-      return centre + sin_c * (std::cos(phi) * ex + std::sin(phi) * ey);
+      return centre + sin_c * (cosine(phi) * ex + sine(phi) * ey);
     };
     auto piece_nodes = [&](const Piece& p, PieceNodes& pn) {
       for (int i = 0; i < 15; ++i) {

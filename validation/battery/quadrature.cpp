@@ -13,7 +13,7 @@ Vec3L cap_direction(const Cap<Real>& cap, Real t, Real phi) {
   const Real omc = t * cap.one_minus_cos;  // 1 - cos(theta)
   const Real cos_t = 1 - omc;
   const Real sin_t = std::sqrt(std::max<Real>(0, omc * (2 - omc)));
-  return f.to_world(Vec3L(sin_t * std::cos(phi), sin_t * std::sin(phi), cos_t));
+  return f.to_world(Vec3L(sin_t * cosine(phi), sin_t * sine(phi), cos_t));
 }
 
 void cap_coordinates(const Cap<Real>& cap, const Vec3L& w, Real& t, Real& phi) {
@@ -178,10 +178,10 @@ std::vector<Real> line_cuts(const std::vector<Vec3L>& boundary_planes, const Vec
   for (const Vec3L& m : boundary_planes) {
     Real theta = std::atan2(-m.dot(a), m.dot(u));
     if (theta < 0) theta += kPi<Real>;
-    const Real t = (1 - std::cos(theta)) / omc_cap;
+    const Real t = (1 - cosine(theta)) / omc_cap;
     if (!(t > t0 && t < t1)) continue;
     const Real sv = (t - t0) / (t1 - t0);
-    const Real v = Real(0.5) - std::sin(std::asin(std::clamp<Real>(1 - 2 * sv, -1, 1)) / 3);
+    const Real v = Real(0.5) - sine(std::asin(std::clamp<Real>(1 - 2 * sv, -1, 1)) / 3);
     if (v > 0 && v < 1) cuts.push_back(v);
   }
   std::sort(cuts.begin(), cuts.end());
@@ -247,7 +247,7 @@ QuadratureResult integrate_cap_region_with_error(const std::function<Real(const 
              line_abs = abs_tol / (2 * omc_cap * std::max<Real>(phi1 - phi0, 1e-300L));
   Real inner_error = 0;  // the worst line's error estimate
   auto inner = [&](Real phi) {
-    const Real c = std::cos(phi), s = std::sin(phi);
+    const Real c = cosine(phi), s = sine(phi);
     // Substitution t = t0 + (t1 - t0)(3v^2 - 2v^3): dt/dv = 6 (t1 - t0) v (1 - v) vanishes at both ends, which
     // turns an inverse-square-root singularity of f at a ring's edge (the visible-area sampler's silhouette)
     // into a bounded integrand. Harmless for smooth f.
