@@ -209,14 +209,21 @@ inline long double exact_product_error(long double a, long double b, long double
   const long double ah = ta - (ta - a), al = a - ah, bh = tb - (tb - b), bl = b - bh;
   return al * bl - (((p - ah * bh) - al * bh) - ah * bl);
 }
+
+// The range where the steps above are exact: magnitudes in (2^-8000, 2^8000) (NaN is outside).
+inline bool within_exact_range(long double x) {
+  const long double ax = std::abs(x);
+  return ax > 0x1p-8000L && ax < 0x1p8000L;
+}
+inline bool below_exact_bound(long double a, long double b) {
+  return std::abs(a) < 0x1p8000L && std::abs(b) < 0x1p8000L;
+}
 }  // namespace detail
 
 // c - a b where c = fl(a b): the product's rounding error, negated, as fused_multiply_add(-a, b, c) gives it.
 template <class T> T negated_product_error(T a, T b, T c) {
   if constexpr (std::is_same_v<T, long double> && kX87LongDouble) {
-    constexpr long double lo = 0x1p-8000L, hi = 0x1p8000L;
-    const long double ac = std::abs(c);
-    if (ac > lo && ac < hi && std::abs(a) < hi && std::abs(b) < hi) {
+    if (detail::within_exact_range(c) && detail::below_exact_bound(a, b)) {
       const long double e = detail::exact_product_error(a, b, c);
       return e == 0 ? 0.0L : -e;  // an exact zero sum is +0 when rounding to nearest
     }
@@ -226,9 +233,8 @@ template <class T> T negated_product_error(T a, T b, T c) {
 
 template <class T> T fused_multiply_add(T a, T b, T c) {
   if constexpr (std::is_same_v<T, long double> && kX87LongDouble) {
-    constexpr long double lo = 0x1p-8000L, hi = 0x1p8000L;
-    const long double p = a * b, ap = std::abs(p), ac = std::abs(c);
-    if (ap > lo && ap < hi && std::abs(a) < hi && std::abs(b) < hi && (c == 0 || (ac > lo && ac < hi))) {
+    const long double p = a * b;
+    if (detail::within_exact_range(p) && detail::below_exact_bound(a, b) && (c == 0 || detail::within_exact_range(c))) {
       long double th, tl;
       detail::two_sum(c, p, th, tl);
       return th + detail::sum_rounded_to_odd(tl, detail::exact_product_error(a, b, p));
