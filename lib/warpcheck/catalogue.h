@@ -15,6 +15,7 @@
 //   kinks_u0(g), kinks_u1(g)   u where the warp is only piecewise smooth (e.g. where u0 passes from one piece
 //                              of the light to the next)
 //   boundary_planes(g)         unit normals of the great circles on which the density may jump or kink
+//   boundary_caps(g)           caps on whose edges (small circles) the density may jump or kink
 //   invert(v, w, u)            the inverse warp: the u that sample() maps to w
 //   rectangles_only            true if the kernel takes rectangles only
 //

@@ -683,6 +683,12 @@ template <class T, SptdBase B> struct SptdCapKernel {
     return c;
   }
   static T normaliser(const View& v) { return v.base_integral; }  // the integral of D over C (Eq. 10)
+  // The cosine base vanishes beyond its horizon: D (Eq. 8) kinks on the edge of g(H), H the base's hemisphere.
+  static std::vector<Cap<T>> boundary_caps(const Geometry& g) {
+    Vec3<T> n;
+    if (kUniform || !valid_pivot(g.sptd.pivot) || !normalize_normal(g.sptd.base_axis, n)) return {};
+    return {pivot_transform_cap(Cap<T>{n, T(1)}, g.sptd.pivot)};
+  }
   // The cosine base near the horizon: x(u0) inverts an area-CDF whose chord length has square-root corners where x
   // passes the ends of the ellipse E and the horizon abscissa x0; y jumps across E at u1 = 1/2 in the crescent.
   static std::vector<T> kinks_u0(const Geometry& g) {

@@ -8,6 +8,7 @@
 #include <boost/math/quadrature/gauss_kronrod.hpp>
 #include <cmath>
 
+#include "battery/circles.h"
 #include "battery/drawing.h"
 
 namespace warpcheck::validation::battery {
@@ -105,54 +106,30 @@ void integrate_pieces(const SamplerUnderTest& s, const std::vector<Piece>& piece
   }
 }
 
-// Boundary planes in the cap's frame.
-std::vector<Vec3L> local_planes(const SamplerUnderTest& s, const CapFrame& cf) {
-  std::vector<Vec3L> m;
-  for (const Vec3L& p : s.boundary_planes)
-    if (p.norm() > 0) m.push_back(cf.fr.to_local(p.normalized()));
-  return m;
+// t of a polar angle theta in [0, pi]: 1 - cos(theta) = 2 sin^2(theta / 2) keeps its precision near the axis.
+void push_t(Real theta, Real omc, std::vector<Real>& t) {
+  const Real sh = sine(theta / 2), x = 2 * sh * sh / omc;
+  if (x > 0 && x < 1) t.push_back(x);
 }
 
-// t where the radial line at azimuth (c, s) crosses each plane m.w = 0: m_z cos(theta) + (m_x c + m_y s)
-// sin(theta) = 0; 1 - cos(theta) = 2 sin^2(theta / 2) keeps its precision near the axis.
-void line_crossings(const std::vector<Vec3L>& m, Real omc, Real c, Real s, std::vector<Real>& t) {
-  for (const Vec3L& p : m) {
-    Real theta = std::atan2(-p.z(), p.x() * c + p.y() * s);
-    if (theta < 0) theta += kPi<Real>;
-    const Real sh = sine(theta / 2), x = 2 * sh * sh / omc;
-    if (x > 0 && x < 1) t.push_back(x);
-  }
+// t where the radial line at azimuth (c, s) crosses each circle.
+void line_crossings(const std::vector<Circle>& m, Real omc, Real c, Real s, std::vector<Real>& t) {
+  std::vector<Real> theta;
+  line_crossing_angles(m, c, s, theta);
+  for (Real x : theta) push_t(x, omc, t);
 }
 
-// phi where the ring of polar angle theta (cos_c, sin_c) crosses each plane: rho cos(phi - psi) = -m_z cot(theta).
-void ring_crossings(const std::vector<Vec3L>& m, Real cos_c, Real sin_c, std::vector<Real>& phi) {
-  for (const Vec3L& p : m) {
-    const Real rho = std::hypot(p.x(), p.y()), psi = std::atan2(p.y(), p.x());
-    if (!(rho > 0) || !(sin_c > 0)) continue;
-    const Real arg = -p.z() * cos_c / (sin_c * rho);
-    if (!(std::abs(arg) <= 1)) continue;
-    for (Real sign : {Real(-1), Real(1)}) {
-      Real x = std::fmod(psi + sign * std::acos(arg), kTwoPi<Real>);
-      if (x < 0) x += kTwoPi<Real>;
-      if (x > 0 && x < kTwoPi<Real>) phi.push_back(x);
-    }
-  }
-}
-
-// Corners of the boundary inside the cap: (t, phi) of +-(m_i x m_j).
-std::vector<std::pair<Real, Real>> corners(const std::vector<Vec3L>& m, Real omc) {
+// Corners of the boundary inside the cap: (t, phi) where two circles meet.
+std::vector<std::pair<Real, Real>> corners(const std::vector<Circle>& m, Real omc) {
   std::vector<std::pair<Real, Real>> out;
   for (std::size_t i = 0; i < m.size(); ++i)
-    for (std::size_t j = i + 1; j < m.size(); ++j) {
-      const Vec3L p = m[i].cross(m[j]);
-      if (!(p.norm() > 0)) continue;
-      for (const Vec3L& q : {Vec3L(p.normalized()), Vec3L(-p.normalized())}) {
+    for (std::size_t j = i + 1; j < m.size(); ++j)
+      for (const Vec3L& q : circle_intersections(m[i], m[j])) {
         const Real t = (q - Vec3L(0, 0, 1)).squaredNorm() / 2 / omc;
         Real phi = std::atan2(q.y(), q.x());
         if (phi < 0) phi += kTwoPi<Real>;
         if (t > 0 && t < 1) out.emplace_back(t, phi);
       }
-    }
   return out;
 }
 
@@ -168,22 +145,54 @@ std::vector<Real> edges_of(std::vector<Real> e, Real lo, Real hi) {
 // A slab [a, b] of the outer variable (phi for lines, t for rings), integrated with Gauss-Legendre 3. With
 // `edge_singular` the rule runs in y = sqrt(1 - x) (x = (1 - y)(1 + y), dx = 2 y dy), which makes an
 // inverse-square-root singularity at x = 1 (the visible-area pdf at the cap's edge, integrated over rings) smooth
-// in every slab; with `cubic` in the cubic substitution of that variable (a square-root kink at an end).
+// in every slab. An end at a tangency of the boundary (bit 1: a, bit 2: b) has a square-root kink: there the rule
+// runs in the quadratic substitution y = a + (b - a) v^2, which makes every power (y - a)^(k/2) a polynomial in v
+// (the cubic 3 v^2 - 2 v^3 where both ends are kinks).
 struct Slab {
   Real a, b;
-  bool cubic;
+  int kinked_ends;
   int depth = 0;
   std::array<Real, 3> x{}, weight{};
   std::array<std::vector<Real>, 3> value;  // the line's (ring's) integral per ring (column) at each node
   long calls = 0;
+  std::vector<Real> parent;  // a kinked slab's parent's rule per component, when it was halved from one
+  int sibling = 0;           // then the offset of the other half in its batch
 };
+
+// The slab's rule per component.
+std::vector<Real> rule(const Slab& sl) {
+  std::vector<Real> r(sl.value[0].size(), 0);
+  for (int i = 0; i < kSlabNodes; ++i)
+    for (std::size_t j = 0; j < r.size(); ++j) r[j] += sl.weight[i] * sl.value[i][j];
+  return r;
+}
+
+// y(v) on [a, b] and dy/dv for the kinked ends (Slab).
+void substitute(Real a, Real b, int kinked_ends, Real v, Real& y, Real& dy) {
+  const Real h = b - a;
+  switch (kinked_ends) {
+    case 0:
+      y = a + h * v, dy = h;
+      return;
+    case 1:
+      y = a + h * v * v, dy = 2 * h * v;
+      return;
+    case 2:
+      y = b - h * (1 - v) * (1 - v), dy = 2 * h * (1 - v);
+      return;
+    default:
+      y = cubic_x(a, b, v), dy = cubic_dx(a, b, v);
+  }
+}
 
 void place_nodes(Slab& sl, bool edge_singular) {
   const Real a = edge_singular ? std::sqrt(1 - sl.b) : sl.a, b = edge_singular ? std::sqrt(1 - sl.a) : sl.b;
+  // y = sqrt(1 - x) reverses the slab: x's end a is y's end b.
+  const int kinked = edge_singular ? ((sl.kinked_ends & 1) << 1) | ((sl.kinked_ends & 2) >> 1) : sl.kinked_ends;
   for (int i = 0; i < kSlabNodes; ++i) {
-    const Real v = kG3v[i];
-    const Real y = sl.cubic ? cubic_x(a, b, v) : a + (b - a) * v;
-    const Real dy = kG3w[i] * (sl.cubic ? cubic_dx(a, b, v) : b - a);
+    Real y, dy;
+    substitute(a, b, kinked, kG3v[i], y, dy);
+    dy *= kG3w[i];
     sl.x[i] = edge_singular ? (1 - y) * (1 + y) : y, sl.weight[i] = edge_singular ? 2 * y * dy : dy;
   }
 }
@@ -201,9 +210,22 @@ bool bends(const Slab& sl, Real threshold) {
   return false;
 }
 
+// Whether the two halves of a kinked slab agree with their parent's rule to `tol` of each component (or of 1e-3 of
+// the total): the kink's higher terms (y - a)^(k/2), k >= 5, escape the 3-point rule in proportion to the slab's
+// width against the boundary's size, which the second difference does not see.
+bool halving_agrees(const Slab& half, const Slab& other, Real tol) {
+  const std::vector<Real> a = rule(half), b = rule(other);
+  Real total = 0;
+  for (Real v : half.parent) total += std::abs(v);
+  for (std::size_t j = 0; j < a.size(); ++j)
+    if (std::abs(a[j] + b[j] - half.parent[j]) > tol * std::max(std::abs(a[j] + b[j]), Real(1e-3) * total))
+      return false;
+  return true;
+}
+
 // Integrates the slabs (eval(x, values, calls) gives the vector of one line or ring), halving a slab that bends
-// (up to max_depth times, 8: to 1/256 of its width, and not below `resolution`), and returns the leaf slabs in
-// order.
+// or, at a kink, until halving agrees with the whole (up to max_depth times, 8: to 1/256 of its width, and not
+// below `resolution`), and returns the leaf slabs in order.
 template <class Eval>
 std::vector<Slab> integrate_slabs(std::vector<Slab> todo, bool edge_singular, const CapGridSpec& sp, const Eval& eval) {
   const int threads = sp.threads;
@@ -216,13 +238,31 @@ std::vector<Slab> integrate_slabs(std::vector<Slab> todo, bool edge_singular, co
       eval(sl.x[k % kSlabNodes], sl.value[k % kSlabNodes], calls);
       std::atomic_ref<long>(sl.calls).fetch_add(calls);
     });
+    // Decided before any slab moves (a half's test reads its sibling). A slab beside one that bends is halved too:
+    // at an inflection point (a peak's flank) the second difference vanishes, the rule's error does not.
+    // todo is sorted (children replace their parent in order), so neighbours are adjacent entries.
+    const std::size_t n = todo.size();
+    std::vector<char> bent(n), halve(n);
+    for (std::size_t k = 0; k < n; ++k) bent[k] = bends(todo[k], sp.bend);
+    for (std::size_t k = 0; k < n; ++k) {
+      const Slab& sl = todo[k];
+      const bool beside_bent =
+          (k > 0 && todo[k - 1].b == sl.a && bent[k - 1]) || (k + 1 < n && sl.b == todo[k + 1].a && bent[k + 1]);
+      halve[k] = sl.depth < sp.max_depth && sl.b - sl.a > 2 * sp.resolution &&
+                 (sl.kinked_ends == 0 ? bent[k] || beside_bent
+                                      : sl.parent.empty() || !halving_agrees(sl, todo[k + sl.sibling], sp.rel_tol));
+    }
     std::vector<Slab> next;
-    for (Slab& sl : todo) {
-      if (sl.depth < sp.max_depth && sl.b - sl.a > 2 * sp.resolution && bends(sl, sp.bend)) {
+    for (std::size_t k = 0; k < n; ++k) {
+      Slab& sl = todo[k];
+      if (halve[k]) {
         const Real mid = (sl.a + sl.b) / 2;
-        done.push_back(Slab{sl.a, sl.b, false, -1, {}, {}, {}, sl.calls});  // keeps the count of calls only
-        next.push_back(Slab{sl.a, mid, sl.cubic, sl.depth + 1, {}, {}, {}, 0});
-        next.push_back(Slab{mid, sl.b, sl.cubic, sl.depth + 1, {}, {}, {}, 0});
+        done.push_back(Slab{sl.a, sl.b, 0, -1, {}, {}, {}, sl.calls});  // keeps the count of calls only
+        Slab left{sl.a, mid, sl.kinked_ends & 1, sl.depth + 1, {}, {}, {}, 0};
+        Slab right{mid, sl.b, sl.kinked_ends & 2, sl.depth + 1, {}, {}, {}, 0};
+        if (sl.kinked_ends != 0) left.parent = right.parent = rule(sl), left.sibling = 1, right.sibling = -1;
+        next.push_back(std::move(left));
+        next.push_back(std::move(right));
       } else {
         done.push_back(std::move(sl));
       }
@@ -234,12 +274,13 @@ std::vector<Slab> integrate_slabs(std::vector<Slab> todo, bool edge_singular, co
   return done;
 }
 
-// The initial slabs between sorted edges; those ending at an edge listed in cubic_at take the cubic substitution.
-std::vector<Slab> slabs_between(const std::vector<Real>& e, const std::vector<Real>& cubic_at) {
+// The initial slabs between sorted edges, with their ends at an edge listed in `kinks_at` marked (Slab).
+std::vector<Slab> slabs_between(const std::vector<Real>& e, const std::vector<Real>& kinks_at) {
   std::vector<Slab> out;
-  auto listed = [&](Real x) { return std::find(cubic_at.begin(), cubic_at.end(), x) != cubic_at.end(); };
+  auto listed = [&](Real x) { return std::find(kinks_at.begin(), kinks_at.end(), x) != kinks_at.end(); };
   for (std::size_t k = 0; k + 1 < e.size(); ++k)
-    if (e[k + 1] > e[k]) out.push_back(Slab{e[k], e[k + 1], listed(e[k]) || listed(e[k + 1]), 0, {}, {}, {}, 0});
+    if (e[k + 1] > e[k])
+      out.push_back(Slab{e[k], e[k + 1], int(listed(e[k])) | int(listed(e[k + 1])) << 1, 0, {}, {}, {}, 0});
   return out;
 }
 
@@ -250,16 +291,18 @@ std::size_t interval_of(const std::vector<Real>& nodes, Real x) {
 }
 
 // The lines: bins (per ring, from lines at each column's slabs) and the azimuth CDF.
-void integrate_lines(const SamplerUnderTest& s, const CapGridSpec& sp, const CapFrame& cf, const std::vector<Vec3L>& m,
+void integrate_lines(const SamplerUnderTest& s, const CapGridSpec& sp, const CapFrame& cf, const std::vector<Circle>& m,
                      CapGrid& out) {
   const int R = sp.radial_bins, A = sp.azimuth_bins;
   std::vector<Real> phi_edges;
   for (Real x : sp.xa) phi_edges.push_back(kTwoPi<Real> * x);
   for (int c = 0; c <= A; ++c) phi_edges.push_back(kTwoPi<Real> * c / A);
   for (const auto& [t, phi] : corners(m, cf.omc)) phi_edges.push_back(phi);
+  const std::vector<Real> tangencies = azimuth_tangencies(m);
+  phi_edges.insert(phi_edges.end(), tangencies.begin(), tangencies.end());
   for (int j = 1; j <= R; ++j) {
     const Real o = Real(j) / R * cf.omc;
-    ring_crossings(m, 1 - o, std::sqrt(std::max<Real>(0, o * (2 - o))), phi_edges);
+    ring_crossing_azimuths(m, 1 - o, std::sqrt(std::max<Real>(0, o * (2 - o))), phi_edges);
   }
   const std::vector<Real> e = edges_of(phi_edges, 0, kTwoPi<Real>);
   // (sin theta, cos theta, dt/dv) at the nodes of each whole ring, in the cubic substitution.
@@ -303,7 +346,7 @@ void integrate_lines(const SamplerUnderTest& s, const CapGridSpec& sp, const Cap
   for (Real x : sp.xa) xa_rad.push_back(kTwoPi<Real> * x);
   std::vector<Real> slab_mass(sp.xa.size() - 1, 0);
   out.bins.assign(std::size_t(R) * A, 0);
-  for (const Slab& sl : integrate_slabs(slabs_between(e, {}), false, sp, line_at)) {
+  for (const Slab& sl : integrate_slabs(slabs_between(e, tangencies), false, sp, line_at)) {
     out.pdf_calls += sl.calls;
     if (sl.depth < 0) continue;
     const Real mid = (sl.a + sl.b) / 2;
@@ -323,20 +366,17 @@ void integrate_lines(const SamplerUnderTest& s, const CapGridSpec& sp, const Cap
 // The rings: bins again (the check) and the radial CDF. Slabs in t end at the KS nodes, the ring edges, and where
 // each column's integrand kinks: tangencies of boundary circles with the rings, corners, and crossings of the
 // boundary with the columns' edges.
-void integrate_rings(const SamplerUnderTest& s, const CapGridSpec& sp, const CapFrame& cf, const std::vector<Vec3L>& m,
+void integrate_rings(const SamplerUnderTest& s, const CapGridSpec& sp, const CapFrame& cf, const std::vector<Circle>& m,
                      CapGrid& out) {
   const int R = sp.radial_bins, A = sp.azimuth_bins;
   std::vector<Real> t_edges(sp.xr.begin(), sp.xr.end()), cuts{1};
   for (int j = 0; j <= R; ++j) t_edges.push_back(Real(j) / R);
-  std::vector<Real> tangencies;
-  for (const auto& [t, phi] : corners(m, cf.omc)) cuts.push_back(t);
-  for (const Vec3L& p : m) {  // tangency of the plane's great circle with the rings: tan(theta) = |m_z| / rho
-    const Real theta = std::atan2(std::abs(p.z()), std::hypot(p.x(), p.y()));
-    for (Real th : {theta, kPi<Real> - theta}) {
-      const Real sh = sine(th / 2);
-      tangencies.push_back(2 * sh * sh / cf.omc);
-    }
+  std::vector<Real> tangencies;  // kept at the cap's ends too, where they mark the end slabs as kinked
+  for (Real theta : polar_tangencies(m)) {
+    const Real sh = sine(theta / 2);
+    tangencies.push_back(2 * sh * sh / cf.omc);
   }
+  for (const auto& [t, phi] : corners(m, cf.omc)) cuts.push_back(t);
   for (int c = 0; c < A; ++c)  // where the boundary crosses a column's edge, a column's integrand kinks
     line_crossings(m, cf.omc, cosine(kTwoPi<Real> * c / A), sine(kTwoPi<Real> * c / A), cuts);
   t_edges.insert(t_edges.end(), cuts.begin(), cuts.end());
@@ -357,7 +397,7 @@ void integrate_rings(const SamplerUnderTest& s, const CapGridSpec& sp, const Cap
     const Real o = t * cf.omc;
     const Real cos_c = 1 - o, sin_c = std::sqrt(std::max<Real>(0, o * (2 - o)));
     std::vector<Real> phi_edges = phi_edges_whole;
-    ring_crossings(m, cos_c, sin_c, phi_edges);
+    ring_crossing_azimuths(m, cos_c, sin_c, phi_edges);
     const std::vector<Real> pe = edges_of(phi_edges, 0, kTwoPi<Real>);
     std::vector<Piece> pieces;
     for (std::size_t i = 0; i + 1 < pe.size(); ++i) {
@@ -385,7 +425,7 @@ void integrate_rings(const SamplerUnderTest& s, const CapGridSpec& sp, const Cap
   };
   std::vector<Real> slab_mass(sp.xr.size() - 1, 0);
   out.bins_check.assign(std::size_t(R) * A, 0);
-  // A column's integrand has a square-root kink at a tangency (the cubic substitution smooths it), a plain kink
+  // A column's integrand has a square-root kink at a tangency (the slab's substitution smooths it), a plain kink
   // at the other cuts (splitting there is enough).
   for (const Slab& sl : integrate_slabs(slabs_between(e, tangencies), true, sp, ring_at)) {
     out.pdf_calls += sl.calls;
@@ -408,7 +448,7 @@ void integrate_rings(const SamplerUnderTest& s, const CapGridSpec& sp, const Cap
 
 CapGrid integrate_cap_grid(const SamplerUnderTest& s, const CapGridSpec& spec) {
   const CapFrame cf(s.bounding_cap);
-  const std::vector<Vec3L> m = local_planes(s, cf);
+  const std::vector<Circle> m = local_circles(boundary_of(s), cf.fr);
   CapGrid g;
   integrate_lines(s, spec, cf, m, g);
   integrate_rings(s, spec, cf, m, g);

@@ -29,7 +29,7 @@ struct CapGrid {
 
 // Radial lines: at the 3 Gauss-Legendre azimuths of every slab between consecutive KS azimuth nodes, column
 // edges and azimuth cuts (corners of the boundary, crossings of boundary circles with ring edges), each line
-// integrated ring by ring with a 15-point Gauss-Kronrod rule, split where it crosses a boundary plane.
+// integrated ring by ring with a 15-point Gauss-Kronrod rule, split where it crosses a boundary circle (circles.h).
 // Rings: the same with t and phi exchanged (KS radial nodes, ring edges, tangencies and corners of the boundary;
 // each ring integrated column by column). Between its cuts each slab's integrand is smooth, which is what the
 // fixed 3-point rule needs; a 1D piece whose Kronrod error estimate exceeds rel_tol is refined adaptively.

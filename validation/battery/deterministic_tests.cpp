@@ -12,7 +12,7 @@ namespace warpcheck::validation::battery {
 Real outside_integral(const SamplerUnderTest& s, const BatteryOptions& o) {
   // The rest of the sphere: t from 1 (the cap's edge) to 2 / omc (the antipode).
   return integrate_cap_region(s.pdf, s.bounding_cap, 1, 2 / s.bounding_cap.one_minus_cos, 0, kTwoPi<Real>,
-                              o.quadrature_tolerance, o.azimuth_bins, 1, s.boundary_planes);
+                              o.quadrature_tolerance, o.azimuth_bins, 1, boundary_of(s));
 }
 
 TestResult pdf_integral(const SamplerUnderTest& s, const BatteryOptions& o, const Expected& e, Real outside) {

@@ -103,7 +103,7 @@ Expected expected_integrals(const SamplerUnderTest& s, const BatteryOptions& o) 
   // The third estimate of the grid's total (grid_shortfall), computed beside the grid.
   auto adaptive = beside(o, [&s, &o] {
     return integrate_cap_region_with_error(s.pdf, s.bounding_cap, 0, 1, 0, kTwoPi<Real>, o.quadrature_tolerance,
-                                           o.azimuth_bins, o.radial_bins, s.boundary_planes);
+                                           o.azimuth_bins, o.radial_bins, boundary_of(s));
   });
   CapGridSpec spec;
   spec.radial_bins = o.radial_bins, spec.azimuth_bins = o.azimuth_bins;

@@ -4,6 +4,7 @@
 #include <boost/math/quadrature/gauss_kronrod.hpp>
 #include <cmath>
 
+#include "battery/circles.h"
 #include "warpcheck/validation/battery.h"
 
 namespace warpcheck::validation {
@@ -165,20 +166,17 @@ QuadratureResult integrate_adaptive(const std::function<Real(Real)>& f, Real a, 
 
 namespace {
 
-// Breakpoints of a radial line where it crosses a boundary great circle m.w = 0 (boundary_planes), in the
-// line's variable v of integrate_cap_region_with_error: w(theta) = cos(theta) a + sin(theta) u with a the cap's
-// axis and u the line's direction, so m.a cos(theta) + m.u sin(theta) = 0 at theta = atan2(-m.a, m.u) mod pi;
-// t = (1 - cos theta) / omc_cap, and v inverts the substitution t(v), v = 1/2 - sin(asin(1 - 2 s) / 3) for
-// s = (t - t0) / (t1 - t0). Integrating each piece on its own keeps a jump or kink of f between the rule's nodes
-// from hiding a thin part of the support (the tip of a polygon's acute corner). Returns {0, cuts..., 1}.
-std::vector<Real> line_cuts(const std::vector<Vec3L>& boundary_planes, const Vec3L& a, const Vec3L& u, Real omc_cap,
-                            Real t0, Real t1) {
-  std::vector<Real> cuts{0, 1};
-  if (boundary_planes.empty()) return cuts;
-  for (const Vec3L& m : boundary_planes) {
-    Real theta = std::atan2(-m.dot(a), m.dot(u));
-    if (theta < 0) theta += kPi<Real>;
-    const Real t = (1 - cosine(theta)) / omc_cap;
+// Breakpoints of a radial line where it crosses a boundary circle (circles.h), in the line's variable v of
+// integrate_cap_region_with_error: t = (1 - cos theta) / omc_cap at each crossing's polar angle, and v inverts the
+// substitution t(v), v = 1/2 - sin(asin(1 - 2 s) / 3) for s = (t - t0) / (t1 - t0). Integrating each piece on its
+// own keeps a jump or kink of f between the rule's nodes from hiding a thin part of the support (the tip of a
+// polygon's acute corner). Returns {0, cuts..., 1}.
+std::vector<Real> line_cuts(const std::vector<battery::Circle>& circles, Real c, Real s, Real omc_cap, Real t0,
+                            Real t1) {
+  std::vector<Real> cuts{0, 1}, theta;
+  battery::line_crossing_angles(circles, c, s, theta);
+  for (Real x : theta) {
+    const Real t = (1 - cosine(x)) / omc_cap;
     if (!(t > t0 && t < t1)) continue;
     const Real sv = (t - t0) / (t1 - t0);
     const Real v = Real(0.5) - sine(std::asin(std::clamp<Real>(1 - 2 * sv, -1, 1)) / 3);
@@ -189,43 +187,29 @@ std::vector<Real> line_cuts(const std::vector<Vec3L>& boundary_planes, const Vec
 }
 
 // Azimuth breakpoints of a region [t0, t1] x [phi0, phi1], sorted, ends included. (1) At the corners of the
-// boundary (where two boundary great circles meet inside the region): at an acute corner whose sides run nearly
+// boundary (where two boundary circles meet inside the region): at an acute corner whose sides run nearly
 // radially, the lines cross the support only within a sliver of azimuth around the corner's, which the outer
-// rule's nodes would step over. (2) Where a boundary circle crosses the region's inner or outer ring (polar
-// angle theta_c): between these azimuths every radial line crosses the same boundaries, so the inner integral is
-// smooth in phi. In the cap's frame, m.w = 0 on the ring is m_x cos(phi) + m_y sin(phi) = -m_z cot(theta_c),
-// i.e. phi = psi +- acos(-m_z cot(theta_c) / hypot(m_x, m_y)).
-std::vector<Real> azimuth_cuts(const std::vector<Vec3L>& boundary_planes, const Frame<Real>& fr, Real omc_cap, Real t0,
-                               Real t1, Real phi0, Real phi1) {
-  std::vector<Real> phi_cuts{phi0, phi1};
+// rule's nodes would step over. (2) Where a boundary circle crosses the region's inner or outer ring: between
+// these azimuths every radial line crosses the same boundaries, so the inner integral is smooth in phi.
+std::vector<Real> azimuth_cuts(const std::vector<battery::Circle>& circles, Real omc_cap, Real t0, Real t1, Real phi0,
+                               Real phi1) {
+  std::vector<Real> phi_cuts{phi0, phi1}, ring;
   auto add_phi_cut = [&](Real phi) {  // phi in (-2 pi, 2 pi), kept when inside the region's azimuth range
     if (phi < 0) phi += kTwoPi<Real>;
     if (phi > phi0 && phi < phi1) phi_cuts.push_back(phi);
   };
-  for (std::size_t i = 0; i < boundary_planes.size(); ++i)
-    for (std::size_t j = i + 1; j < boundary_planes.size(); ++j) {
-      const Vec3L p = boundary_planes[i].cross(boundary_planes[j]);
-      if (!(p.norm() > 0)) continue;
-      for (const Vec3L& q : {Vec3L(p.normalized()), Vec3L(-p.normalized())}) {
-        const Vec3L l = fr.to_local(q);
+  for (std::size_t i = 0; i < circles.size(); ++i)
+    for (std::size_t j = i + 1; j < circles.size(); ++j)
+      for (const Vec3L& l : battery::circle_intersections(circles[i], circles[j])) {
         const Real t = (1 - l.z()) / omc_cap;
-        if (!(t >= t0 && t <= t1)) continue;
-        add_phi_cut(std::atan2(l.y(), l.x()));
+        if (t >= t0 && t <= t1) add_phi_cut(std::atan2(l.y(), l.x()));
       }
-    }
-  for (const Vec3L& m : boundary_planes) {
-    const Vec3L ml = fr.to_local(m);
-    const Real rho = std::hypot(ml.x(), ml.y()), psi = std::atan2(ml.y(), ml.x());
-    if (!(rho > 0)) continue;
-    for (Real t : {t0, t1}) {
-      const Real cos_c = 1 - t * omc_cap;
-      if (!(t > 0) || !(cos_c > -1)) continue;
-      const Real sin_c = std::sqrt(std::max<Real>(0, (1 - cos_c) * (1 + cos_c)));
-      const Real arg = -ml.z() * cos_c / (sin_c * rho);
-      if (!(std::abs(arg) <= 1)) continue;
-      for (Real sign : {Real(-1), Real(1)}) add_phi_cut(std::fmod(psi + sign * std::acos(arg), kTwoPi<Real>));
-    }
+  for (Real t : {t0, t1}) {
+    const Real cos_c = 1 - t * omc_cap;
+    if (!(t > 0) || !(cos_c > -1)) continue;
+    battery::ring_crossing_azimuths(circles, cos_c, std::sqrt(std::max<Real>(0, (1 - cos_c) * (1 + cos_c))), ring);
   }
+  for (Real phi : ring) add_phi_cut(phi);
   std::sort(phi_cuts.begin(), phi_cuts.end());
   return phi_cuts;
 }
@@ -234,13 +218,13 @@ std::vector<Real> azimuth_cuts(const std::vector<Vec3L>& boundary_planes, const 
 
 QuadratureResult integrate_cap_region_with_error(const std::function<Real(const Vec3L&)>& f, const Cap<Real>& cap,
                                                  Real t0, Real t1, Real phi0, Real phi1, Real tol, int azimuth_panels,
-                                                 int radial_panels, const std::vector<Vec3L>& boundary_planes,
-                                                 Real abs_tol) {
+                                                 int radial_panels, const Boundary& boundary, Real abs_tol) {
   // Panel budget per line: a jump needs ~35 bisections to reach 1e-10 of the line's integral; 64 leaves room
   // for two jumps, and bounds the cost of a noisy integrand at 64 * 15 evaluations per line.
   constexpr int kMaxPanels = 64;
   const Frame<Real> fr = Frame<Real>::from_z(cap.axis);
   const Real omc_cap = cap.one_minus_cos;
+  const std::vector<battery::Circle> circles = battery::local_circles(boundary, fr);
   // The region's integral is omc_cap * (outer integral over phi of the lines' integrals): half of abs_tol to the
   // outer rule, half to the lines, spread over the azimuth range.
   const Real outer_abs = abs_tol / (2 * omc_cap),
@@ -260,7 +244,7 @@ QuadratureResult integrate_cap_region_with_error(const std::function<Real(const 
       const Real val = f(w);
       return std::isfinite(val) ? val * dt : Real(0);
     };
-    const std::vector<Real> cuts = line_cuts(boundary_planes, cap.axis, fr.to_world(Vec3L(c, s, 0)), omc_cap, t0, t1);
+    const std::vector<Real> cuts = line_cuts(circles, c, s, omc_cap, t0, t1);
     Real value = 0, error = 0;
     for (std::size_t i = 0; i + 1 < cuts.size(); ++i) {
       if (!(cuts[i + 1] > cuts[i])) continue;
@@ -272,7 +256,7 @@ QuadratureResult integrate_cap_region_with_error(const std::function<Real(const 
     return value;
   };
   // d(omega) = d(cos theta) d(phi) = omc_cap dt dphi.
-  const std::vector<Real> phi_cuts = azimuth_cuts(boundary_planes, fr, omc_cap, t0, t1, phi0, phi1);
+  const std::vector<Real> phi_cuts = azimuth_cuts(circles, omc_cap, t0, t1, phi0, phi1);
   QuadratureResult outer{0, 0};
   for (std::size_t i = 0; i + 1 < phi_cuts.size(); ++i) {
     if (!(phi_cuts[i + 1] > phi_cuts[i])) continue;
@@ -286,10 +270,10 @@ QuadratureResult integrate_cap_region_with_error(const std::function<Real(const 
 }
 
 Real integrate_cap_region(const std::function<Real(const Vec3L&)>& f, const Cap<Real>& cap, Real t0, Real t1, Real phi0,
-                          Real phi1, Real tol, int azimuth_panels, int radial_panels,
-                          const std::vector<Vec3L>& boundary_planes, Real abs_tol) {
-  return integrate_cap_region_with_error(f, cap, t0, t1, phi0, phi1, tol, azimuth_panels, radial_panels,
-                                         boundary_planes, abs_tol)
+                          Real phi1, Real tol, int azimuth_panels, int radial_panels, const Boundary& boundary,
+                          Real abs_tol) {
+  return integrate_cap_region_with_error(f, cap, t0, t1, phi0, phi1, tol, azimuth_panels, radial_panels, boundary,
+                                         abs_tol)
       .value;
 }
 

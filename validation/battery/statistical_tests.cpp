@@ -18,7 +18,7 @@ std::vector<Real> reference_bin_masses(const SamplerUnderTest& s, const BatteryO
   parallel_for(mass.size(), thread_count(o), [&](std::size_t k) {
     const int ri = int(k / A), ai = int(k % A);
     mass[k] = integrate_cap_region(s.pdf, s.bounding_cap, Real(ri) / R, Real(ri + 1) / R, kTwoPi<Real> * ai / A,
-                                   kTwoPi<Real> * (ai + 1) / A, o.quadrature_tolerance, 1, 1, s.boundary_planes);
+                                   kTwoPi<Real> * (ai + 1) / A, o.quadrature_tolerance, 1, 1, boundary_of(s));
   });
   return mass;
 }
@@ -156,10 +156,10 @@ KsCdfs reference_ks_cdfs(const SamplerUnderTest& s, const BatteryOptions& o) {
   parallel_for(std::size_t(2 * M), thread_count(o), [&](std::size_t k) {
     if (k < std::size_t(M))
       dr[k] = integrate_cap_region(s.pdf, cap, xr[k], xr[k + 1], 0, kTwoPi<Real>, ks_tol, o.azimuth_bins, 1,
-                                   s.boundary_planes, ks_abs);
+                                   boundary_of(s), ks_abs);
     else
       da[k - M] = integrate_cap_region(s.pdf, cap, 0, 1, kTwoPi<Real> * xa[k - M], kTwoPi<Real> * xa[k - M + 1], ks_tol,
-                                       1, o.radial_bins, s.boundary_planes, ks_abs);
+                                       1, o.radial_bins, boundary_of(s), ks_abs);
   });
   std::vector<Real> Fr(M + 1, 0), Fa(M + 1, 0);
   for (int k = 0; k < M; ++k) Fr[k + 1] = Fr[k] + dr[k], Fa[k + 1] = Fa[k] + da[k];

@@ -90,13 +90,22 @@ QuadratureResult integrate_adaptive(const std::function<Real(Real)>& f, Real a, 
 // abs_tol: an absolute accuracy of the region's integral that is enough (0: none, relative tol alone). Lines
 // that barely touch the support have tiny values, and a relative tolerance there asks for ever more bisections of
 // a jump that the pdf's own rounding blurs (a float pdf): see ks_cdfs.
+// Where a pdf may jump or kink (SamplerUnderTest's boundary_planes and boundary_caps): the quadratures split their
+// lines and rings there.
+struct Boundary {
+  std::vector<Vec3L> planes;
+  std::vector<Cap<Real>> caps;
+  Boundary(std::vector<Vec3L> p = {}, std::vector<Cap<Real>> c = {}) : planes(std::move(p)), caps(std::move(c)) {}
+};
+inline Boundary boundary_of(const SamplerUnderTest& s) { return Boundary(s.boundary_planes, s.boundary_caps); }
+
 QuadratureResult integrate_cap_region_with_error(const std::function<Real(const Vec3L&)>& f, const Cap<Real>& cap,
                                                  Real t0, Real t1, Real phi0, Real phi1, Real tol = 1e-10L,
                                                  int azimuth_panels = 1, int radial_panels = 1,
-                                                 const std::vector<Vec3L>& boundary_planes = {}, Real abs_tol = 0);
+                                                 const Boundary& boundary = {}, Real abs_tol = 0);
 Real integrate_cap_region(const std::function<Real(const Vec3L&)>& f, const Cap<Real>& cap, Real t0, Real t1, Real phi0,
                           Real phi1, Real tol = 1e-10L, int azimuth_panels = 1, int radial_panels = 1,
-                          const std::vector<Vec3L>& boundary_planes = {}, Real abs_tol = 0);
+                          const Boundary& boundary = {}, Real abs_tol = 0);
 
 // The direction with coordinates (t, phi) in the cap's frame, and back.
 Vec3L cap_direction(const Cap<Real>& cap, Real t, Real phi);

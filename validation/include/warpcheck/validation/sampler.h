@@ -75,6 +75,9 @@ struct SamplerUnderTest {
   // crosses one, so that parts of the support thinner than its nodes' spacing (an acute corner's tip) keep
   // their mass. Without them a polygon seen 0.3 deg from its plane lost 0.25% of its mass.
   std::vector<Vec3L> boundary_planes;
+  // Optional: caps on whose edges (small circles) the pdf may jump or kink, e.g. where a pivot transform maps a
+  // clamped cosine's horizon. The grid quadrature splits at them as at boundary_planes.
+  std::vector<Cap<Real>> boundary_caps;
   // Optional block forms of sample and pdf, for speed: out[i] = sample(u0[i], u1[i]) and out[i] = pdf(w[i]), bit
   // for bit, with the per-light work and the call paid once per block. bind_kernel fills both; sample_many and
   // pdf_many below fall back to the single forms.
@@ -150,8 +153,16 @@ template <Kernel K> std::vector<Vec3L> kernel_boundary_planes(const typename K::
   return planes;
 }
 
+// A kernel's boundary caps (catalogue.h), empty if it declares none.
+template <Kernel K> std::vector<Cap<Real>> kernel_boundary_caps(const typename K::Geometry& g) {
+  std::vector<Cap<Real>> caps;
+  if constexpr (requires { K::boundary_caps(g); })
+    for (const auto& c : K::boundary_caps(g)) caps.push_back(Cap<Real>{to_long(c.axis), Real(c.one_minus_cos)});
+  return caps;
+}
+
 // Binds kernel K to geometry g (in K's scalar type; the caller converts it): sample and pdf on one view of g,
-// K's bounding cap, kinks and boundary planes.
+// K's bounding cap, kinks, boundary planes and caps.
 template <Kernel K> SamplerUnderTest bind_kernel(std::string config, const typename K::Geometry& g) {
   using T = typename K::Scalar;
   SamplerUnderTest s;
@@ -174,11 +185,12 @@ template <Kernel K> SamplerUnderTest bind_kernel(std::string config, const typen
   s.kinks_u0 = kernel_kinks<K>(g, 0);
   s.kinks_u1 = kernel_kinks<K>(g, 1);
   s.boundary_planes = kernel_boundary_planes<K>(g);
+  s.boundary_caps = kernel_boundary_caps<K>(g);
   return s;
 }
 
 // As above, with KRef (the same kernel in long double, on the same geometry converted) as the reference warp;
-// the bounding cap, the kinks and the boundary planes come from KRef.
+// the bounding cap, the kinks and the boundary planes and caps come from KRef.
 template <Kernel K, Kernel KRef>
 SamplerUnderTest bind_kernel(std::string config, const typename K::Geometry& g, const typename KRef::Geometry& g_ref) {
   SamplerUnderTest s = bind_kernel<K>(std::move(config), g);
@@ -192,6 +204,7 @@ SamplerUnderTest bind_kernel(std::string config, const typename K::Geometry& g, 
   s.kinks_u0 = kernel_kinks<KRef>(g_ref, 0);
   s.kinks_u1 = kernel_kinks<KRef>(g_ref, 1);
   s.boundary_planes = kernel_boundary_planes<KRef>(g_ref);
+  s.boundary_caps = kernel_boundary_caps<KRef>(g_ref);
   return s;
 }
 
