@@ -344,24 +344,24 @@ SamplerUnderTest scaled_cone(Real pdf_factor, Real sample_factor) {
   return s;
 }
 
-const TestResult& result_named(const std::vector<TestResult>& results, const std::string& test) {
-  for (const TestResult& r : results)
-    if (r.test == test) return r;
-  throw std::runtime_error("no result " + test);
-}
-
 BatteryOptions few_samples() {
   BatteryOptions o;
   o.samples = 1000;  // the deterministic tests do not depend on it
   return o;
 }
 
+// The result named test of a battery run on s.
+TestResult battery_result(const SamplerUnderTest& s, const std::string& test) {
+  for (TestResult& r : run_battery(s, few_samples()))
+    if (r.test == test) return r;
+  throw std::runtime_error("no result " + test);
+}
+
 TEST(DeterministicKnownAnswers, ThePdfIntegralOfAConeWithHalfItsMassScaledByOneAndAHalfIsOffByAQuarter) {
   // integral = 1.5 * 1/2 + 1/2 = 1.25: the statistic |integral - 1| = 0.25, to the quadrature's 1e-8.
-  const std::vector<TestResult> r = run_battery(scaled_cone(1.5L, 1.5L), few_samples());
-  const TestResult& integral = result_named(r, "pdf-integral");
-  EXPECT_NEAR(integral.statistic, 0.25, 1e-8) << integral.detail;
-  EXPECT_FALSE(integral.passed);
+  const TestResult r = battery_result(scaled_cone(1.5L, 1.5L), "pdf-integral");
+  EXPECT_NEAR(r.statistic, 0.25, 1e-8) << r.detail;
+  EXPECT_FALSE(r.passed);
 }
 
 TEST(DeterministicKnownAnswers, ThePdfIntegralCountsTheMassOutsideTheBoundingCap) {
@@ -377,27 +377,24 @@ TEST(DeterministicKnownAnswers, ThePdfIntegralCountsTheMassOutsideTheBoundingCap
   };
   s.pdf = [=](const Vec3L&) { return density; };
   EXPECT_NEAR(double(battery::outside_integral(s, few_samples())), 0.85, 1e-9);
-  const std::vector<TestResult> r = run_battery(s, few_samples());
-  const TestResult& integral = result_named(r, "pdf-integral");
-  EXPECT_NEAR(integral.statistic, 0, 1e-8) << integral.detail;
-  EXPECT_TRUE(integral.passed) << integral.detail;
+  const TestResult r = battery_result(s, "pdf-integral");
+  EXPECT_NEAR(r.statistic, 0, 1e-8) << r.detail;
+  EXPECT_TRUE(r.passed) << r.detail;
 }
 
 TEST(DeterministicKnownAnswers, PdfConsistencyReportsTheFactorBetweenTheReturnedPdfAndTheAreaElement) {
   // Returned pdf and pdf(direction) both 1.02 times the density on the inner half: pdf(direction) agrees with the
   // returned pdf, and the returned pdf times the area element is 1.02 there.
-  const std::vector<TestResult> r = run_battery(scaled_cone(1.02L, 1.02L), few_samples());
-  const TestResult& c = result_named(r, "pdf-consistency");
-  EXPECT_NEAR(c.statistic, 0.02, 1e-6) << c.detail;
-  EXPECT_FALSE(c.passed);
+  const TestResult r = battery_result(scaled_cone(1.02L, 1.02L), "pdf-consistency");
+  EXPECT_NEAR(r.statistic, 0.02, 1e-6) << r.detail;
+  EXPECT_FALSE(r.passed);
 }
 
 TEST(DeterministicKnownAnswers, PdfConsistencyReportsTheFactorBetweenPdfOfTheDirectionAndTheReturnedPdf) {
   // The returned pdf is right; pdf(direction) is 1.03 times it on the inner half: |pdf(dir) / pdf - 1| = 0.03.
-  const std::vector<TestResult> r = run_battery(scaled_cone(1.03L, 1), few_samples());
-  const TestResult& c = result_named(r, "pdf-consistency");
-  EXPECT_NEAR(c.statistic, 0.03, 1e-6) << c.detail;
-  EXPECT_FALSE(c.passed);
+  const TestResult r = battery_result(scaled_cone(1.03L, 1), "pdf-consistency");
+  EXPECT_NEAR(r.statistic, 0.03, 1e-6) << r.detail;
+  EXPECT_FALSE(r.passed);
 }
 
 // ---- Calibration, fast ----------------------------------------------------------------------------------------
