@@ -246,8 +246,8 @@ std::vector<Slab> integrate_slabs(std::vector<Slab> todo, bool edge_singular, co
     for (std::size_t k = 0; k < n; ++k) bent[k] = bends(todo[k], sp.bend);
     for (std::size_t k = 0; k < n; ++k) {
       const Slab& sl = todo[k];
-      const bool beside_bent =
-          (k > 0 && todo[k - 1].b == sl.a && bent[k - 1]) || (k + 1 < n && sl.b == todo[k + 1].a && bent[k + 1]);
+      const bool beside_bent = sp.beside_bends && ((k > 0 && todo[k - 1].b == sl.a && bent[k - 1]) ||
+                                                   (k + 1 < n && sl.b == todo[k + 1].a && bent[k + 1]));
       halve[k] = sl.depth < sp.max_depth && sl.b - sl.a > 2 * sp.resolution &&
                  (sl.kinked_ends == 0 ? bent[k] || beside_bent
                                       : sl.parent.empty() || !halving_agrees(sl, todo[k + sl.sibling], sp.rel_tol));

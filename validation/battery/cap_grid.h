@@ -17,6 +17,7 @@ struct CapGridSpec {
                                             // scalar cannot tell directions closer than that apart)
   Real bend = 1e-2L;                        // a slab is halved where its second difference exceeds this
   int max_depth = 8;                        // ... up to this many times
+  bool beside_bends = true;                 // ... and so is a slab beside one that bends (cap_grid.cpp)
   int threads = 1;
 };
 
