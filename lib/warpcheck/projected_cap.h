@@ -64,8 +64,13 @@ template <class T> struct CutDiskX {
 template <class T> T solve_cut_disk_angle(T target) {
   if (!(target > T(0))) return T(0);
   if (target >= kPi<T> / T(2)) return kPi<T> / T(2);
-  // From the small-angle asymptote C ~ 2 theta^3 / 3.
-  const T guess = std::min(std::cbrt(T(1.5) * target), kPi<T> / T(2));
+  // From the small-angle asymptote C ~ 2 theta^3 / 3; in long double from the double root, 53 of the 62 bits
+  // asked for, which leaves Newton two steps instead of five or six (an x87 sine costs three double ones).
+  T guess = std::min(std::cbrt(T(1.5) * target), kPi<T> / T(2));
+  if constexpr (std::is_same_v<T, long double>) {
+    const double root = solve_cut_disk_angle(double(target));
+    if (root > 0) guess = root;
+  }
   std::uintmax_t iterations = 60;
   return boost::math::tools::newton_raphson_iterate(
       [target](T th) {
