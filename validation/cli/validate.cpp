@@ -346,6 +346,7 @@ int validate_main(const std::vector<std::string>& a) {
   }
   const auto start = std::chrono::steady_clock::now();
   Progress progress(cases.size(), v.quiet);
+  ResultTexts texts;  // the checkpoints' text of the results so far
   for (const Case* c : cases) {
     const std::string label = c->kernel + " / " + c->scalar + " / " + c->config;
     v.opt.progress = progress.during(label);
@@ -357,14 +358,14 @@ int validate_main(const std::vector<std::string>& a) {
       BatteryRun partial = run;
       apply_correction(partial.results, run.alpha, run.correction);
       partial.complete = false;
-      write_file_atomically(v.json, to_json(partial));
+      write_file_atomically(v.json, to_json(partial, &texts));
     }
   }
   progress.end();
   apply_correction(run.results, run.alpha, run.correction);
   run.complete = true;
   print_summary(run, cases.size(), std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-  if (!v.json.empty()) write_file_atomically(v.json, to_json(run));
+  if (!v.json.empty()) write_file_atomically(v.json, to_json(run, &texts));
   return all_passed(run.results) ? 0 : 1;
 }
 

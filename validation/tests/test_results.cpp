@@ -11,6 +11,7 @@
 #include <random>
 #include <sstream>
 
+#include "warpcheck/validation/battery.h"
 #include "warpcheck/validation/results.h"
 
 namespace warpcheck::validation {
@@ -102,6 +103,23 @@ TEST(ResultsJson, EveryDoubleReadsBackBitForBit) {
   ASSERT_EQ(back.results.size(), run.results.size());
   for (std::size_t i = 0; i < run.results.size(); ++i) expect_same_bits(run.results[i], back.results[i]);
   EXPECT_EQ(to_json(back), text);
+}
+
+// A long run's checkpoints keep the text of the results written so far: after more results arrive and the
+// correction over the run flips an earlier result's verdict, the text equals a fresh write.
+TEST(ResultsJson, ACheckpointWithKeptTextsEqualsAFreshWriteAfterTheCorrectionChanges) {
+  BatteryRun run;
+  run.results = {chi2_result(3.5, 0.004, {1.5, 2.5}), deterministic_result(1e-9)};
+  ResultTexts texts;
+  apply_correction(run.results, run.alpha, run.correction);  // m = 1: 0.004 <= 0.01 rejects
+  EXPECT_EQ(to_json(run, &texts), to_json(run));
+  ASSERT_FALSE(run.results[0].passed);
+  run.results.push_back(chi2_result(1.0, 0.5, {}));
+  run.results.push_back(chi2_result(2.0, 0.3, {4.25}));
+  apply_correction(run.results, run.alpha, run.correction);  // m = 3: 0.004 > 0.01 / 3 passes
+  ASSERT_TRUE(run.results[0].passed);
+  EXPECT_EQ(to_json(run, &texts), to_json(run));
+  EXPECT_EQ(texts.parts.size(), run.results.size());
 }
 
 TEST(ResultsJson, ReadsNumbersExactlyWhereBoostJsonParseDoesNot) {

@@ -19,6 +19,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace warpcheck::validation {
@@ -54,7 +55,15 @@ struct BatteryRun {
   std::size_t statistical_tests() const;
 };
 
-std::string to_json(const BatteryRun& run);
+// The JSON text of results before and after their "passed" member (the one member the correction over a run may
+// change), kept between the checkpoints of a long run so that each one writes only its new results.
+struct ResultTexts {
+  std::vector<std::pair<std::string, std::string>> parts;  // by index into BatteryRun::results
+};
+
+// With `texts`, the results already in it are not written again (they must be the run's first results, unchanged
+// but for "passed"), and the new ones are added.
+std::string to_json(const BatteryRun& run, ResultTexts* texts = nullptr);
 // Reads what to_json writes. Throws std::runtime_error naming the first missing or mistyped member.
 BatteryRun parse_battery_json(const std::string& text);
 
