@@ -165,8 +165,8 @@ inline float cube_root_squared_for_float(float x) {
 // the floating-point environment (~200 ns a call). fused_multiply_add gives the same bits from Dekker's exact
 // product (Veltkamp halves of 32 bits) and Boldo & Melquiond's FMA emulation (IEEE TC 2008, Sec. 5: c + a b as
 // three exact terms, the low parts summed rounded to odd, then one rounding to nearest). Both steps are exact
-// only without overflow and underflow, so operands or a product outside [2^-8000, 2^8000], zeros, Inf and NaN
-// take std::fma (test: FusedMultiplyAdd.*).
+// only without overflow and underflow, so operands or a product outside [2^-8000, 2^8000], Inf and NaN take
+// std::fma; a zero factor makes the product an exact signed zero (test: FusedMultiplyAdd.*).
 inline constexpr bool kX87LongDouble =
 #if defined(__x86_64__) || defined(__i386__)
     std::numeric_limits<long double>::digits == 64;
@@ -223,6 +223,8 @@ inline bool below_exact_bound(long double a, long double b) {
 // c - a b where c = fl(a b): the product's rounding error, negated, as fused_multiply_add(-a, b, c) gives it.
 template <class T> T negated_product_error(T a, T b, T c) {
   if constexpr (std::is_same_v<T, long double> && kX87LongDouble) {
+    // c = fl(a b) is a zero, and -a b the zero of the other sign: their sum is +0.
+    if ((a == 0 || b == 0) && std::isfinite(a) && std::isfinite(b)) return 0.0L;
     if (detail::within_exact_range(c) && detail::below_exact_bound(a, b)) {
       const long double e = detail::exact_product_error(a, b, c);
       return e == 0 ? 0.0L : -e;  // an exact zero sum is +0 when rounding to nearest
@@ -234,6 +236,7 @@ template <class T> T negated_product_error(T a, T b, T c) {
 template <class T> T fused_multiply_add(T a, T b, T c) {
   if constexpr (std::is_same_v<T, long double> && kX87LongDouble) {
     const long double p = a * b;
+    if ((a == 0 || b == 0) && std::isfinite(a) && std::isfinite(b)) return c + p;  // a b = p exactly, a signed zero
     if (detail::within_exact_range(p) && detail::below_exact_bound(a, b) && (c == 0 || detail::within_exact_range(c))) {
       long double th, tl;
       detail::two_sum(c, p, th, tl);

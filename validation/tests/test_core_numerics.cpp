@@ -73,8 +73,12 @@ TEST(FusedMultiplyAdd, LongDoubleGivesTheBitsOfStdFmaOutsideItsExactRangeAndForS
   const LD values[] = {0.0L, -0.0L, 1.0L, -3.5L, 0x1p-9000L, 0x1p9000L, tiny, huge, inf, -inf, nan, 0x1.8p-16382L};
   int bad = 0;
   for (const LD a : values)
-    for (const LD b : values)
+    for (const LD b : values) {
       for (const LD c : values) bad += mismatches_against_std_fma(a, b, c);
+      const LD p = a * b, expected = std::fma(-a, b, p), got = negated_product_error(a, b, p);
+      bad += !((expected == got && std::signbit(expected) == std::signbit(got)) ||
+               (std::isnan(expected) && std::isnan(got)));
+    }
   EXPECT_EQ(bad, 0);
 }
 
