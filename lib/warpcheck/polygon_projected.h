@@ -259,7 +259,9 @@ Vec2<T> invert_decentral_sector(const ProjectedSector<T>& s, T target, int itera
 template <class T> Vec2<T> invert_central_sector(const ProjectedSector<T>& s, T target) {
   const T a = std::abs(s.outer.nz);
   const T phi = a > T(0) ? std::min(T(2) * target / a, kPi<T>) : T(0);
-  const T b1 = sine(phi), b2 = a * cosine(phi);
+  T b1, cos_phi;
+  sine_cosine(phi, b1, cos_phi);
+  const T b2 = a * cos_phi;
   const Vec2<T> r1(-s.s0.y(), s.s0.x());
   const Vec2<T> r2 = s.outer.times(s.s0);
   return l1_normalized(Vec2<T>(r1.y() * b2 - r2.y() * b1, r2.x() * b1 - r1.x() * b2));

@@ -266,7 +266,8 @@ template <class T> DirectionSample<T> sample_polygon_solid_angle(const PolygonSo
   if (k < 0) return DirectionSample<T>::none(NoSample::kTooSmall);
   const Vec3<T>&v0 = f.u[0], &v1 = f.u[k], &v2 = f.u[k + 1];
   const T g0 = v.g0[k], g1 = v.g1[k], g2 = v.g2[k];  // as for the area (make_polygon_solid_angle_view)
-  const T c = cosine(a / 2), s = sine(a / 2);
+  T s, c;
+  sine_cosine(a / 2, s, c);
   const Vec3<T> r = (g0 * c - g1 * s) * v0 + (g2 * s) * v2;
   const T r2 = r.squaredNorm();
   // Scaled before the product, as G0 in make_polygon_solid_angle_view (|p_2| |p_0| underflows for tiny p).
@@ -333,10 +334,12 @@ template <class T> DirectionSample<T> sample_arvo_triangle_fan(const ArvoFanView
   if (k < 0) return DirectionSample<T>::none(NoSample::kTooSmall);
   const Vec3<T>&A = v.fan.u[0], &B = v.fan.u[k], &C = v.fan.u[k + 1];
   const T alpha = v.alpha[k];
-  const T s = sine(ahat - alpha), t = cosine(ahat - alpha);
-  const T uu = t - cosine(alpha), vv = s + sine(alpha) * A.dot(B);
+  T s, t, sin_alpha, cos_alpha;
+  sine_cosine(ahat - alpha, s, t);
+  sine_cosine(alpha, sin_alpha, cos_alpha);
+  const T uu = t - cos_alpha, vv = s + sin_alpha * A.dot(B);
   // Arvo 1995's q; a zero denominator takes the limit of the clamped quotient, +-1 by the numerator's sign.
-  const T q_num = (vv * t - uu * s) * cosine(alpha) - vv, q_den = (vv * s + uu * t) * sine(alpha);
+  const T q_num = (vv * t - uu * s) * cos_alpha - vv, q_den = (vv * s + uu * t) * sin_alpha;
   const T q = q_den != T(0) ? std::clamp(q_num / q_den, T(-1), T(1)) : (q_num < T(0) ? T(-1) : T(1));
   const Vec3<T> chat = q * A + std::sqrt(T(1) - q * q) * safe_normalized(Vec3<T>(C - C.dot(A) * A));
   const T z = T(1) - xi[1] * (T(1) - chat.dot(B));

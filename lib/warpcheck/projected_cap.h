@@ -149,8 +149,10 @@ template <class T, CutDiskInverse M>
     out.half_height2 = hh2;
   } else {
     const T theta = solve_cut_disk_angle(e);  // C(theta) = e: the area beyond |x| = cos(theta)
-    out.x = positive ? cosine(theta) : -cosine(theta);
-    out.half_height = sine(theta);
+    T sin_theta, cos_theta;
+    sine_cosine(theta, sin_theta, cos_theta);
+    out.x = positive ? cos_theta : -cos_theta;
+    out.half_height = sin_theta;
   }
   return out;
 }

@@ -85,7 +85,9 @@ template <class T> DirectionSample<T> sample_sphere_solid_angle(const SphereView
   const T sin_theta = std::sqrt(std::max(T(0), one_minus_cos * (T(2) - one_minus_cos)));
   const T phi = kTwoPi<T> * u[1];
   DirectionSample<T> s;
-  s.direction = renormalized(v.frame.to_world(Vec3<T>(sin_theta * cosine(phi), sin_theta * sine(phi), cos_theta)));
+  T sin_phi, cos_phi;
+  sine_cosine(phi, sin_phi, cos_phi);
+  s.direction = renormalized(v.frame.to_world(Vec3<T>(sin_theta * cos_phi, sin_theta * sin_phi, cos_theta)));
   s.pdf = sphere_solid_angle_density(v);
   return s;
 }
@@ -117,7 +119,9 @@ DirectionSample<T> sample_sphere_visible_area(const SphereView<T>& v, const Sphe
   const T phi = kTwoPi<T> * u[1];
   // Point on the sphere relative to the shading point, in the view frame (z towards the centre):
   // p - x = d z + r m, m = (sin_a cos phi, sin_a sin phi, -cos_a).
-  const Vec3<T> local(r * sin_a * cosine(phi), r * sin_a * sine(phi), d - r * cos_a);
+  T sin_phi, cos_phi;
+  sine_cosine(phi, sin_phi, cos_phi);
+  const Vec3<T> local(r * sin_a * cos_phi, r * sin_a * sin_phi, d - r * cos_a);
   const T dist = local.stableNorm();
   // |p - x| beyond T's range (radius ~1e308): the density is not representable either. Tested before local / dist,
   // whose renormalisation would divide by zero.

@@ -74,7 +74,9 @@ DirectionSample<T> sample_spherical_rectangle(const SphericalRectangleView<T>& v
   const T au = xi[0] * v.solid_angle + v.k;
   // sin(au) = 0 at the ends of the range: fu is +-infinite there (its limit; Urena et al. 2013 Sec. 4), without
   // dividing by zero.
-  const T fu_num = cosine(au) * v.b0 - v.b1, sin_au = sine(au);
+  T sin_au, cos_au;
+  sine_cosine(au, sin_au, cos_au);
+  const T fu_num = cos_au * v.b0 - v.b1;
   const T fu = sin_au != T(0) ? fu_num / sin_au
                               : std::copysign(std::numeric_limits<T>::infinity(), fu_num) * std::copysign(T(1), sin_au);
   // The same for the other quotients below: a zero denominator takes the clamped limit instead of dividing.

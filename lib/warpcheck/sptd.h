@@ -348,8 +348,8 @@ template <class T> T cap_intersection_solid_angle(const Cap<T>& c1, const Cap<T>
   if (p2 - p1 >= pd) return a1;                                                   // the smaller cap inside the larger
   if (p1 + p2 <= pd) return T(0);                                                 // disjoint
   if (p1 + p2 + pd >= kTwoPi<T>) return std::max(T(0), a1 + a2 - T(4) * kPi<T>);  // union covers the sphere
-  const T c1c = cosine(p1), c2c = cosine(p2), cd = cosine(pd);
-  const T s1 = sine(p1), s2 = sine(p2), sd = sine(pd);
+  T c1c, c2c, cd, s1, s2, sd;
+  sine_cosine(p1, s1, c1c), sine_cosine(p2, s2, c2c), sine_cosine(pd, sd, cd);
   auto acos_c = [](T x) { return std::acos(std::clamp(x, T(-1), T(1))); };
   const T b = kTwoPi<T> - kTwoPi<T> * c1c - kTwoPi<T> * c2c - T(2) * acos_c((cd - c1c * c2c) / (s1 * s2)) +
               T(2) * c1c * acos_c((c1c * cd - c2c) / (s1 * sd)) + T(2) * c2c * acos_c((c2c * cd - c1c) / (s2 * sd));
@@ -384,7 +384,9 @@ template <class T> Vec3<T> uniform_cap_offset_local(T cap_one_minus_cos, const V
   const T omc = u[0] * std::min(T(2), cap_one_minus_cos);
   const T sin_t = std::sqrt(std::max(T(0), omc * (T(2) - omc)));
   const T phi = kTwoPi<T> * u[1];
-  return Vec3<T>(sin_t * cosine(phi), sin_t * sine(phi), -omc);
+  T sin_phi, cos_phi;
+  sine_cosine(phi, sin_phi, cos_phi);
+  return Vec3<T>(sin_t * cos_phi, sin_t * sin_phi, -omc);
 }
 template <class T> Vec3<T> sample_uniform_cap_direction(const Cap<T>& c, const Vec2<T>& u) {
   const Vec3<T> w =
@@ -434,7 +436,11 @@ template <class T> CosineCapChord<T> invert_cosine_cap_cdf(const CosineCapView<T
     const auto r = boost::math::tools::toms748_solve(f, lo, hi, flo, fhi, tol, iters);
     q = (r.first + r.second) / T(2);
   }
-  if (upper_tail) return {cosine(q), sine(q), T(0), sine(q), true};
+  if (upper_tail) {
+    T sin_q, cos_q;
+    sine_cosine(q, sin_q, cos_q);
+    return {cos_q, sin_q, T(0), sin_q, true};
+  }
   if (by_s) {
     const auto ch = v.crescent_chord(q);
     return {v.x0 + q, ch.c, ch.m, ch.w, false};
@@ -452,8 +458,10 @@ template <class T> Vec3<T> sample_cosine_cap_direction(const CosineCapView<T>& v
   T x, y, z;
   if (v.ellipse_only) {
     const T r = std::sqrt(u[0]), phi = kTwoPi<T> * u[1];
-    x = v.xc + v.A * r * cosine(phi);
-    y = v.sin_a * r * sine(phi);
+    T sin_phi, cos_phi;
+    sine_cosine(phi, sin_phi, cos_phi);
+    x = v.xc + v.A * r * cos_phi;
+    y = v.sin_a * r * sin_phi;
     z = std::sqrt(std::max(T(0), (T(1) - x) * (T(1) + x) - y * y));
   } else {
     const sptd_detail::CosineCapChord<T> ch = sptd_detail::invert_cosine_cap_cdf(v, u[0]);

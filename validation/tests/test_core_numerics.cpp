@@ -102,10 +102,15 @@ TEST(SineCosine, LongDoubleIsWithinOneAndAHalfUlpsOfA50DigitReferenceAsSinlAndCo
   double worst = 0, worst_std = 0;
   auto check = [&](LD x) {
     const Reference s = sin(Reference(x)), c = cos(Reference(x));
-    worst = std::max({worst, ulps_from(sine(x), s), ulps_from(cosine(x), c)});
+    LD both_s, both_c;
+    sine_cosine(x, both_s, both_c);
+    worst =
+        std::max({worst, ulps_from(sine(x), s), ulps_from(cosine(x), c), ulps_from(both_s, s), ulps_from(both_c, c)});
     worst_std = std::max({worst_std, ulps_from(std::sin(x), s), ulps_from(std::cos(x), c)});
   };
   for (int i = 0; i < 20000; ++i) {
+    // |x| below pi/4, where no reduction is made.
+    check(std::ldexp(LD(rng() | (1ull << 63)), -64 - int(rng() % 30)) * 0.78L);
     // |x| in [1/2, 2^13): both sides of the reduced range's bound 2^12.
     const LD x = std::ldexp(LD(rng() | (1ull << 63)), -64 + int(rng() % 14));
     check((rng() & 1) ? x : -x);
@@ -120,6 +125,10 @@ TEST(SineCosine, FloatAndDoubleAreStdSinAndCos) {
   for (const double x : {0.3, 1.0, 2.5, -7.0, 1e5}) {
     EXPECT_EQ(sine(x), std::sin(x));
     EXPECT_EQ(cosine(float(x)), std::cos(float(x)));
+    double s, c;
+    sine_cosine(x, s, c);
+    EXPECT_EQ(s, std::sin(x));
+    EXPECT_EQ(c, std::cos(x));
   }
 }
 
