@@ -257,9 +257,9 @@ std::vector<Slab> integrate_slabs(std::vector<Slab> todo, bool edge_singular, co
       Slab& sl = todo[k];
       if (halve[k]) {
         const Real mid = (sl.a + sl.b) / 2;
-        done.push_back(Slab{sl.a, sl.b, 0, -1, {}, {}, {}, sl.calls});  // keeps the count of calls only
-        Slab left{sl.a, mid, sl.kinked_ends & 1, sl.depth + 1, {}, {}, {}, 0};
-        Slab right{mid, sl.b, sl.kinked_ends & 2, sl.depth + 1, {}, {}, {}, 0};
+        done.push_back(Slab{sl.a, sl.b, 0, -1, {}, {}, {}, sl.calls, {}, 0});  // keeps the count of calls only
+        Slab left{sl.a, mid, sl.kinked_ends & 1, sl.depth + 1, {}, {}, {}, 0, {}, 0};
+        Slab right{mid, sl.b, sl.kinked_ends & 2, sl.depth + 1, {}, {}, {}, 0, {}, 0};
         if (sl.kinked_ends != 0) left.parent = right.parent = rule(sl), left.sibling = 1, right.sibling = -1;
         next.push_back(std::move(left));
         next.push_back(std::move(right));
@@ -280,7 +280,7 @@ std::vector<Slab> slabs_between(const std::vector<Real>& e, const std::vector<Re
   auto listed = [&](Real x) { return std::find(kinks_at.begin(), kinks_at.end(), x) != kinks_at.end(); };
   for (std::size_t k = 0; k + 1 < e.size(); ++k)
     if (e[k + 1] > e[k])
-      out.push_back(Slab{e[k], e[k + 1], int(listed(e[k])) | int(listed(e[k + 1])) << 1, 0, {}, {}, {}, 0});
+      out.push_back(Slab{e[k], e[k + 1], int(listed(e[k])) | int(listed(e[k + 1])) << 1, 0, {}, {}, {}, 0, {}, 0});
   return out;
 }
 
