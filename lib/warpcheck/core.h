@@ -218,13 +218,17 @@ inline bool within_exact_range(long double x) {
 inline bool below_exact_bound(long double a, long double b) {
   return std::abs(a) < 0x1p8000L && std::abs(b) < 0x1p8000L;
 }
+// A finite product with a zero factor: exactly a signed zero.
+inline bool exact_zero_product(long double a, long double b) {
+  return (a == 0 || b == 0) && std::isfinite(a) && std::isfinite(b);
+}
 }  // namespace detail
 
 // c - a b where c = fl(a b): the product's rounding error, negated, as fused_multiply_add(-a, b, c) gives it.
 template <class T> T negated_product_error(T a, T b, T c) {
   if constexpr (std::is_same_v<T, long double> && kX87LongDouble) {
     // c = fl(a b) is a zero, and -a b the zero of the other sign: their sum is +0.
-    if ((a == 0 || b == 0) && std::isfinite(a) && std::isfinite(b)) return 0.0L;
+    if (detail::exact_zero_product(a, b)) return 0.0L;
     if (detail::within_exact_range(c) && detail::below_exact_bound(a, b)) {
       const long double e = detail::exact_product_error(a, b, c);
       return e == 0 ? 0.0L : -e;  // an exact zero sum is +0 when rounding to nearest
@@ -236,7 +240,7 @@ template <class T> T negated_product_error(T a, T b, T c) {
 template <class T> T fused_multiply_add(T a, T b, T c) {
   if constexpr (std::is_same_v<T, long double> && kX87LongDouble) {
     const long double p = a * b;
-    if ((a == 0 || b == 0) && std::isfinite(a) && std::isfinite(b)) return c + p;  // a b = p exactly, a signed zero
+    if (detail::exact_zero_product(a, b)) return c + p;
     if (detail::within_exact_range(p) && detail::below_exact_bound(a, b) && (c == 0 || detail::within_exact_range(c))) {
       long double th, tl;
       detail::two_sum(c, p, th, tl);

@@ -349,7 +349,9 @@ template <class T> T cap_intersection_solid_angle(const Cap<T>& c1, const Cap<T>
   if (p1 + p2 <= pd) return T(0);                                                 // disjoint
   if (p1 + p2 + pd >= kTwoPi<T>) return std::max(T(0), a1 + a2 - T(4) * kPi<T>);  // union covers the sphere
   T c1c, c2c, cd, s1, s2, sd;
-  sine_cosine(p1, s1, c1c), sine_cosine(p2, s2, c2c), sine_cosine(pd, sd, cd);
+  sine_cosine(p1, s1, c1c);
+  sine_cosine(p2, s2, c2c);
+  sine_cosine(pd, sd, cd);
   auto acos_c = [](T x) { return std::acos(std::clamp(x, T(-1), T(1))); };
   const T b = kTwoPi<T> - kTwoPi<T> * c1c - kTwoPi<T> * c2c - T(2) * acos_c((cd - c1c * c2c) / (s1 * s2)) +
               T(2) * c1c * acos_c((c1c * cd - c2c) / (s1 * sd)) + T(2) * c2c * acos_c((c2c * cd - c1c) / (s2 * sd));

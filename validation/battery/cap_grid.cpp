@@ -107,8 +107,12 @@ void integrate_pieces(const SamplerUnderTest& s, const std::vector<Piece>& piece
 }
 
 // t of a polar angle theta in [0, pi]: 1 - cos(theta) = 2 sin^2(theta / 2) keeps its precision near the axis.
+Real t_of_polar(Real theta, Real omc) {
+  const Real sh = sine(theta / 2);
+  return 2 * sh * sh / omc;
+}
 void push_t(Real theta, Real omc, std::vector<Real>& t) {
-  const Real sh = sine(theta / 2), x = 2 * sh * sh / omc;
+  const Real x = t_of_polar(theta, omc);
   if (x > 0 && x < 1) t.push_back(x);
 }
 
@@ -372,10 +376,7 @@ void integrate_rings(const SamplerUnderTest& s, const CapGridSpec& sp, const Cap
   std::vector<Real> t_edges(sp.xr.begin(), sp.xr.end()), cuts{1};
   for (int j = 0; j <= R; ++j) t_edges.push_back(Real(j) / R);
   std::vector<Real> tangencies;  // kept at the cap's ends too, where they mark the end slabs as kinked
-  for (Real theta : polar_tangencies(m)) {
-    const Real sh = sine(theta / 2);
-    tangencies.push_back(2 * sh * sh / cf.omc);
-  }
+  for (Real theta : polar_tangencies(m)) tangencies.push_back(t_of_polar(theta, cf.omc));
   for (const auto& [t, phi] : corners(m, cf.omc)) cuts.push_back(t);
   for (int c = 0; c < A; ++c)  // where the boundary crosses a column's edge, a column's integrand kinks
     line_crossings(m, cf.omc, cosine(kTwoPi<Real> * c / A), sine(kTwoPi<Real> * c / A), cuts);
