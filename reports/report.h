@@ -5,8 +5,8 @@
 //   index.html        pass/fail matrix (kernel x scalar x config by test), the failing list first, alpha and
 //                     correction; then the data sections (claims beside the paper, worst cases, fuzz, bench)
 //   kernel-<k>.html   one page per kernel: its results, per chi2 test the observed / expected / signed
-//                     residual maps (PNG in the page, 32-bit float OpenEXR beside it), and sample sets (a grid
-//                     and a blue-noise set in primary sample space mapped by the kernel) as inline SVG
+//                     residual maps (PNG in the page, 32-bit float OpenEXR beside it), and the sample sets
+//                     build/sample_sets computed (a grid and a blue-noise set mapped by the kernel) as inline SVG
 // A missing optional input gives a section that says "not run" and the command that produces it.
 //
 // The pieces are exposed so tests can check them one by one.
@@ -21,7 +21,6 @@
 #include <vector>
 
 #include "warpcheck/validation/results.h"
-#include "warpcheck/validation/sampler.h"
 
 namespace warpcheck::validation::report {
 
@@ -57,26 +56,33 @@ std::vector<float> read_exr_channel(const std::string& path, const std::string& 
 
 // ---- Sample sets -------------------------------------------------------------------------------------------------
 
-// n x n cell centres of the unit square, row-major in u1 then u0.
-std::vector<std::array<double, 2>> regular_grid(int n);
-// n points of the unit square by Mitchell's best-candidate algorithm (each new point is the farthest, in the
-// toroidal metric, from the points placed so far among `candidates` uniform candidates), from a fixed seed.
-// O(n^2 candidates): about 3e7 distance evaluations for the report's 1024 points.
-std::vector<std::array<double, 2>> best_candidate_blue_noise(int n, std::uint64_t seed, int candidates = 32);
-
+// The sample sets build/sample_sets wrote (validation/tools/sample_sets.cpp documents the JSON): points of primary
+// sample space and the directions a case's sampler maps them to, in the bounding cap's equal-area view.
 struct MappedPoint {
-  double x = 0, y = 0;   // equal-area projection of the direction into the bounding cap's frame: sqrt(t) (cos, sin)
-  bool valid = false;    // the sampler returned a sample
+  double x = 0, y = 0;   // sqrt(t) (cos phi, sin phi) in the bounding cap's frame
+  bool valid = false;    // the sampler returned a direction
   bool outside = false;  // the direction lies outside the bounding cap (t > 1)
 };
-std::vector<MappedPoint> map_points(const SamplerUnderTest& s, const std::vector<std::array<double, 2>>& u);
+struct SampleSetCase {
+  std::string kernel, scalar, config, description, error;  // error: the case could not be built
+  bool expect_no_sample = false;
+  std::vector<MappedPoint> grid, blue;  // grid: grid_lines u0 = const lines, then as many u1 = const lines
+};
+struct SampleSets {
+  int grid_lines = 0, grid_line_samples = 0;
+  std::vector<std::array<double, 2>> blue_u;  // the blue-noise points in primary sample space
+  std::vector<SampleSetCase> cases;
+};
+// Throws std::runtime_error naming what is missing or inconsistent.
+SampleSets parse_sample_sets(const std::string& json_text);
 
 // Inline SVG of a sample set: primary sample space on the left, the mapped directions on the right (unit
-// disk = bounding cap), points coloured by their (u0, u1) so the correspondence shows. With grid_lines, the
-// points are polylines of `line_samples` points along each of `lines` lines u0 = const and u1 = const.
-std::string sample_set_svg(const SamplerUnderTest& s, const std::vector<std::array<double, 2>>& points,
+// disk = bounding cap), points coloured by their (u0, u1) so the correspondence shows. The grid version draws
+// each line and its image as polylines, broken where a point is declined or the image jumps.
+std::string sample_set_svg(const std::vector<std::array<double, 2>>& u, const std::vector<MappedPoint>& mapped,
                            const std::string& title);
-std::string grid_lines_svg(const SamplerUnderTest& s, int lines, int line_samples, const std::string& title);
+std::string grid_lines_svg(int lines, int line_samples, const std::vector<MappedPoint>& mapped,
+                           const std::string& title);
 
 // ---- Plots ---------------------------------------------------------------------------------------------------
 
@@ -92,11 +98,10 @@ std::string svg_line_plot(const std::vector<Series>& series, const std::string& 
 // ---- The site ----------------------------------------------------------------------------------------------------
 
 struct ReportOptions {
-  std::string out_dir;              // created if missing
-  std::string results_path;         // battery JSON (required)
-  std::string data_dir;             // claims, worst cases, fuzz, bench; empty: no data sections read
-  int sample_cases_per_kernel = 3;  // registry cases drawn as sample sets per kernel
-  int grid_lines = 17, grid_line_samples = 96, blue_noise_points = 1024;
+  std::string out_dir;           // created if missing
+  std::string results_path;      // battery JSON (required)
+  std::string data_dir;          // claims, worst cases, fuzz, bench; empty: no data sections read
+  std::string sample_sets_path;  // build/sample_sets's JSON; empty or missing: the pages say how to produce it
 };
 
 struct ReportSummary {

@@ -11,8 +11,6 @@
 #include <sstream>
 
 #include "report.h"
-#include "warpcheck/validation/negative_controls.h"
-#include "warpcheck/validation/registry.h"
 
 namespace warpcheck::validation::report {
 namespace fs = std::filesystem;
@@ -301,39 +299,38 @@ std::string chi2_maps(const TestResult& r, std::optional<long long> samples, con
 
 // ---- sample sets ----------------------------------------------------------------------------------------------
 
-std::string sample_sets(const std::string& kernel, const std::vector<const Case*>& cases,
-                        const std::set<std::string>& configs_in_run, const ReportOptions& opt,
-                        const std::vector<std::array<double, 2>>& blue) {
-  std::vector<const Case*> mine;
-  for (const Case* c : cases)
-    if (c->kernel == kernel) mine.push_back(c);
+// Up to the file's cases of this kernel, the configurations of this run first (the tool already ordered them).
+std::string sample_sets(const std::string& kernel, const SampleSets* sets, const std::set<std::string>& configs_in_run,
+                        const ReportOptions& opt) {
+  if (!sets)
+    return not_run((opt.sample_sets_path.empty() ? std::string("no sample-sets file given")
+                                                 : opt.sample_sets_path + " does not exist"),
+                   "build/sample_sets --out reports/sample-sets.json --from reports/results.json");
+  std::vector<const SampleSetCase*> mine;
+  for (const SampleSetCase& c : sets->cases)
+    if (c.kernel == kernel) mine.push_back(&c);
   if (mine.empty())
-    return "<p class=\"muted\">No registry case named " + html_escape(kernel) + " in this build: no sample sets.</p>\n";
-  // Prefer configurations of this run, then double precision; one case per configuration.
-  std::stable_sort(mine.begin(), mine.end(), [&](const Case* a, const Case* b) {
-    const int ka = (configs_in_run.count(a->config) ? 0 : 2) + (a->scalar == "double" ? 0 : 1);
-    const int kb = (configs_in_run.count(b->config) ? 0 : 2) + (b->scalar == "double" ? 0 : 1);
-    return ka < kb;
+    return "<p class=\"muted\">" + html_escape(opt.sample_sets_path) + " holds no sample set of " +
+           html_escape(kernel) + ".</p>\n";
+  std::stable_sort(mine.begin(), mine.end(), [&](const SampleSetCase* a, const SampleSetCase* b) {
+    return configs_in_run.count(a->config) > configs_in_run.count(b->config);
   });
   std::ostringstream o;
-  o << "<p class=\"muted\">Primary sample space (left) mapped by the kernel (right): a grid of " << opt.grid_lines
-    << " + " << opt.grid_lines << " lines and " << opt.blue_noise_points
-    << " blue-noise points (best candidate, seed 1), coloured by (u0, u1). Red crosses: directions outside the "
-       "bounding cap.</p>\n";
-  std::set<std::string> done;
-  for (const Case* c : mine) {
-    if (int(done.size()) >= opt.sample_cases_per_kernel) break;
-    if (!done.insert(c->config).second) continue;
+  o << "<p class=\"muted\">Primary sample space (left) mapped by the kernel (right): a grid of " << sets->grid_lines
+    << " + " << sets->grid_lines << " lines and " << sets->blue_u.size()
+    << " blue-noise points (best candidate), coloured by (u0, u1). Red crosses: directions outside the bounding cap. "
+       "From <code>"
+    << html_escape(opt.sample_sets_path) << "</code>.</p>\n";
+  for (const SampleSetCase* c : mine) {
     const std::string label = c->kernel + " / " + c->scalar + " / " + c->config;
     o << "<h4>" << html_escape(label) << "</h4><p class=\"muted\">" << html_escape(c->description) << "</p>";
-    try {
-      const SamplerUnderTest s = c->make();
-      if (s.expect_no_sample) o << "<p>This geometry must give no sample; every point is declined.</p>";
-      o << grid_lines_svg(s, opt.grid_lines, opt.grid_line_samples, label + ": grid") << "\n"
-        << sample_set_svg(s, blue, label + ": blue noise") << "\n";
-    } catch (const std::exception& e) {
-      o << "<p class=\"notrun\">Could not build this case: " << html_escape(e.what()) << "</p>";
+    if (!c->error.empty()) {
+      o << "<p class=\"notrun\">Could not build this case: " << html_escape(c->error) << "</p>";
+      continue;
     }
+    if (c->expect_no_sample) o << "<p>This geometry must give no sample; every point is declined.</p>";
+    o << grid_lines_svg(sets->grid_lines, sets->grid_line_samples, c->grid, label + ": grid") << "\n"
+      << sample_set_svg(sets->blue_u, c->blue, label + ": blue noise") << "\n";
   }
   return o.str();
 }
@@ -814,14 +811,6 @@ Grouped group(const BatteryRun& run, ReportSummary& sum) {
   return g;
 }
 
-// What the kernel pages draw sample sets from: the registry's and the negative controls' cases, and one
-// blue-noise point set.
-struct SampleSources {
-  Registry registry = default_registry(), controls = negative_control_registry();
-  std::vector<const Case*> cases;
-  std::vector<std::array<double, 2>> blue;
-};
-
 std::string results_table(const std::vector<const TestResult*>& rs) {
   std::ostringstream p;
   p << "<h2>Results</h2><table><tr><th>scalar</th><th>config</th><th>test</th><th>statistic</th>"
@@ -839,7 +828,7 @@ std::string results_table(const std::vector<const TestResult*>& rs) {
 }
 
 void write_kernel_page(const std::string& k, const std::vector<const TestResult*>& rs, const BatteryRun& run,
-                       const ReportOptions& opt, const SampleSources& src, ReportSummary& sum) {
+                       const ReportOptions& opt, const SampleSets* sets, ReportSummary& sum) {
   const fs::path out(opt.out_dir);
   std::ostringstream p;
   p << page_start("warpcheck: " + k) << "<p><a href=\"index.html\">&larr; all kernels</a></p><h1>" << html_escape(k)
@@ -862,7 +851,7 @@ void write_kernel_page(const std::string& k, const std::vector<const TestResult*
          "no-sample geometry).</p>";
   std::set<std::string> configs;
   for (const TestResult* r : rs) configs.insert(r->config);
-  p << "<h2>Sample sets</h2>\n" << sample_sets(k, src.cases, configs, opt, src.blue) << page_end();
+  p << "<h2>Sample sets</h2>\n" << sample_sets(k, sets, configs, opt) << page_end();
   write_text(out / kernel_page(k), p.str());
   sum.files.push_back(kernel_page(k));
 }
@@ -972,11 +961,11 @@ ReportSummary write_report(const ReportOptions& opt) {
   ReportSummary sum;
   sum.results = run.results.size();
   const Grouped g = group(run, sum);
-  SampleSources src;
-  for (const auto& c : src.registry.cases()) src.cases.push_back(&c);
-  for (const auto& c : src.controls.cases()) src.cases.push_back(&c);
-  src.blue = best_candidate_blue_noise(opt.blue_noise_points, 1);
-  for (const std::string& k : g.kernels) write_kernel_page(k, g.by_kernel.at(k), run, opt, src, sum);
+  std::optional<SampleSets> sets;
+  if (!opt.sample_sets_path.empty() && fs::exists(opt.sample_sets_path))
+    sets = parse_sample_sets(read_text(opt.sample_sets_path));
+  for (const std::string& k : g.kernels)
+    write_kernel_page(k, g.by_kernel.at(k), run, opt, sets ? &*sets : nullptr, sum);
   write_index(run, opt, g, sum);
   return sum;
 }

@@ -1,18 +1,16 @@
 // The report's inline SVG: sample sets mapped by a kernel (the style of Fig. 7 of Peters & Dachsbacher 2019 and
 // Fig. 13 of Peters 2021: primary sample space beside the directions it maps to) and line plots.
 //
-// Hand-rolled on purpose: Debian packages no blue-noise point-set library and no C++ SVG plotting library, and
-// both pieces are a few dozen lines. The blue noise is Mitchell's best-candidate algorithm (1991) with a fixed
-// seed, which is enough to show how a kernel distorts a well-spread set.
+// Hand-rolled on purpose: Debian packages no C++ SVG plotting library, and the pieces are a few dozen lines. The
+// points come from build/sample_sets (parse_sample_sets); nothing here runs a sampler.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
-#include <random>
 #include <sstream>
+#include <stdexcept>
 
 #include "report.h"
-#include "warpcheck/validation/battery.h"
 
 namespace warpcheck::validation::report {
 namespace {
@@ -63,67 +61,16 @@ std::pair<double, double> disk_xy(const MappedPoint& p) {
 
 }  // namespace
 
-std::vector<std::array<double, 2>> regular_grid(int n) {
-  std::vector<std::array<double, 2>> out;
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i) out.push_back({(i + 0.5) / n, (j + 0.5) / n});
-  return out;
-}
-
-std::vector<std::array<double, 2>> best_candidate_blue_noise(int n, std::uint64_t seed, int candidates) {
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> U(0.0, 1.0);
-  std::vector<std::array<double, 2>> out;
-  out.reserve(std::size_t(std::max(n, 0)));
-  auto torus_d2 = [](const std::array<double, 2>& a, const std::array<double, 2>& b) {
-    double dx = std::abs(a[0] - b[0]), dy = std::abs(a[1] - b[1]);
-    dx = std::min(dx, 1 - dx), dy = std::min(dy, 1 - dy);
-    return dx * dx + dy * dy;
-  };
-  for (int k = 0; k < n; ++k) {
-    std::array<double, 2> best{U(rng), U(rng)};
-    double best_d = -1;
-    const int m = k == 0 ? 1 : std::max(candidates, 1);
-    for (int c = 0; c < m; ++c) {
-      const std::array<double, 2> cand = c == 0 ? best : std::array<double, 2>{U(rng), U(rng)};
-      double d = std::numeric_limits<double>::infinity();
-      for (const auto& p : out) d = std::min(d, torus_d2(cand, p));
-      if (d > best_d) best_d = d, best = cand;
-    }
-    out.push_back(best);
-  }
-  return out;
-}
-
-std::vector<MappedPoint> map_points(const SamplerUnderTest& s, const std::vector<std::array<double, 2>>& u) {
-  std::vector<MappedPoint> out;
-  out.reserve(u.size());
-  for (const auto& p : u) {
-    MappedPoint m;
-    const Sample x = s.sample(p[0], p[1]);
-    if (x.valid && std::isfinite(double(x.direction.norm())) && x.direction.norm() > 0) {
-      Real t, phi;
-      cap_coordinates(s.bounding_cap, Vec3L(x.direction.normalized()), t, phi);
-      const double rho = std::sqrt(std::max(0.0, double(t)));
-      m.x = rho * std::cos(double(phi));
-      m.y = rho * std::sin(double(phi));
-      m.valid = std::isfinite(m.x) && std::isfinite(m.y);
-      m.outside = double(t) > 1 + 1e-9;
-    }
-    out.push_back(m);
-  }
-  return out;
-}
-
-std::string sample_set_svg(const SamplerUnderTest& s, const std::vector<std::array<double, 2>>& points,
+std::string sample_set_svg(const std::vector<std::array<double, 2>>& u, const std::vector<MappedPoint>& mapped,
                            const std::string& title) {
-  const std::vector<MappedPoint> mapped = map_points(s, points);
+  if (u.size() != mapped.size())
+    throw std::invalid_argument("sample_set_svg: points and mapped points differ in number");
   std::size_t valid = 0, outside = 0;
   for (const auto& m : mapped) valid += m.valid, outside += m.valid && m.outside;
   std::ostringstream o;
   o << frame_svg(title, valid, mapped.size() - valid, outside);
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    const auto& p = points[i];
+  for (std::size_t i = 0; i < u.size(); ++i) {
+    const auto& p = u[i];
     const std::string c = point_color(p[0], p[1]);
     o << "<circle cx=\"" << f2(kSquareX + kSide * p[0]) << "\" cy=\"" << f2(kSquareY + kSide * (1 - p[1]))
       << "\" r=\"1.5\" fill=\"" << c << "\"/>";
@@ -138,23 +85,26 @@ std::string sample_set_svg(const SamplerUnderTest& s, const std::vector<std::arr
   return o.str();
 }
 
-std::string grid_lines_svg(const SamplerUnderTest& s, int lines, int line_samples, const std::string& title) {
+std::string grid_lines_svg(int lines, int line_samples, const std::vector<MappedPoint>& mapped,
+                           const std::string& title) {
+  if (lines < 1 || line_samples < 2 || mapped.size() != std::size_t(2 * lines * line_samples))
+    throw std::invalid_argument("grid_lines_svg: " + std::to_string(mapped.size()) + " mapped points for " +
+                                std::to_string(lines) + " + " + std::to_string(lines) + " lines of " +
+                                std::to_string(line_samples));
   std::ostringstream body;
   std::size_t valid = 0, total = 0, outside = 0;
   for (int dir = 0; dir < 2; ++dir)
     for (int i = 0; i < lines; ++i) {
       const double fixed = lines > 1 ? double(i) / (lines - 1) : 0.5;
-      std::vector<std::array<double, 2>> u;
-      for (int k = 0; k < line_samples; ++k) {
-        const double v = double(k) / (line_samples - 1);
-        u.push_back(dir == 0 ? std::array<double, 2>{fixed, v} : std::array<double, 2>{v, fixed});
-      }
-      const std::vector<MappedPoint> m = map_points(s, u);
+      const auto first = mapped.begin() + std::ptrdiff_t((dir * lines + i) * line_samples);
+      const std::vector<MappedPoint> m(first, first + line_samples);
       const std::string c = dir == 0 ? point_color(fixed, 0.2) : point_color(0.2, fixed);
       // The line in primary sample space.
+      const std::array<double, 2> ends[2] = {
+          dir == 0 ? std::array<double, 2>{fixed, 0} : std::array<double, 2>{0, fixed},
+          dir == 0 ? std::array<double, 2>{fixed, 1} : std::array<double, 2>{1, fixed}};
       body << "<polyline fill=\"none\" stroke=\"" << c << "\" stroke-width=\"1\" points=\"";
-      for (const auto& p : {u.front(), u.back()})
-        body << f2(kSquareX + kSide * p[0]) << "," << f2(kSquareY + kSide * (1 - p[1])) << " ";
+      for (const auto& p : ends) body << f2(kSquareX + kSide * p[0]) << "," << f2(kSquareY + kSide * (1 - p[1])) << " ";
       body << "\"/>";
       // Its image, broken where a sample is declined or the image jumps (a seam of the warp).
       std::string pts;

@@ -1,6 +1,6 @@
 // The HTML report (report.h): a report generated from a small battery run, including one negative control,
 // opens in headless Chromium with every image decoded, every relative link and anchor present, no script or
-// console error; a failing kernel is marked at a glance; the pieces (JSON model, PNG/EXR, blue noise) hold.
+// console error; a failing kernel is marked at a glance; the pieces (JSON model, PNG/EXR, sample sets) hold.
 //
 // Chromium (Debian package `chromium`, installed by scripts/setup.sh) is required: without it these tests fail
 // rather than skip, since they are the only check that the report renders.
@@ -19,6 +19,7 @@
 #include <sstream>
 
 #include "report.h"
+#include "tools/sample_sets.h"
 #include "warpcheck/validation/battery.h"
 #include "warpcheck/validation/negative_controls.h"
 #include "warpcheck/validation/registry.h"
@@ -173,10 +174,18 @@ const Fixture& fixture() {
     std::ofstream(x.data / "worst-cases" / "example.json")
         << R"({"search":"example","worst_error":1e-9,"paper":"1.8e-5","evaluations":300,"command":"warpcheck worst-case",)"
            R"("history":[{"evaluations":100,"best":1e-12},{"evaluations":200,"best":1e-10},[300,1e-9]]})";
+    // The kernels' sample sets, as build/sample_sets writes them.
+    const Registry controls = negative_control_registry();
+    std::vector<const Case*> sets;
+    for (const Case* c : reg.select({"sphere-solid-angle"}, {"near"}))
+      if (c->scalar == "double") sets.push_back(c);
+    for (const Case* c : controls.select({x.control}, {})) sets.push_back(c);
+    std::ofstream(x.dir / "sample-sets.json") << sample_sets::sample_sets_json(sets, "test");
     ReportOptions ro;
     ro.out_dir = x.site.string();
     ro.results_path = x.results.string();
     ro.data_dir = x.data.string();
+    ro.sample_sets_path = (x.dir / "sample-sets.json").string();
     write_report(ro);
     return x;
   }();
@@ -378,8 +387,8 @@ TEST(Report, ResidualMapExrHoldsTheSignedResidualOfEveryBin) {
   EXPECT_EQ(checked, 2u);
 }
 
-TEST(Report, BlueNoiseIsReproducibleAndBetterSpreadThanUniformRandom) {
-  const auto a = best_candidate_blue_noise(256, 7), b = best_candidate_blue_noise(256, 7);
+TEST(SampleSets, BlueNoiseIsReproducibleAndBetterSpreadThanUniformRandom) {
+  const auto a = sample_sets::best_candidate_blue_noise(256, 7), b = sample_sets::best_candidate_blue_noise(256, 7);
   ASSERT_EQ(a, b);
   auto min_dist = [](const std::vector<std::array<double, 2>>& p) {
     double d = 1;
@@ -428,4 +437,73 @@ TEST(Report, KnownLimitationFailuresAreMarkedDistinctlyAndDoNotFailTheRun) {
   EXPECT_NE(index.find("sidak correction"), std::string::npos);
   EXPECT_NE(index.find("Not run: no data directory given"), std::string::npos);
   EXPECT_NE(index.find("id=\"geometry-maps\""), std::string::npos);  // the table of contents' target
+}
+
+// A report whose results name kernel "k" and whose sample-sets file is `sets_json` (nothing when empty); returns
+// the kernel page.
+std::string kernel_page_with_sample_sets(const fs::path& dir, const std::string& sets_json) {
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir / "r.json")
+      << R"({"alpha":0.01,"correction":"holm","statistical_tests":0,"results":[{"kernel":"k","scalar":"double",)"
+         R"("config":"c","test":"pdf-integral","statistic":1e-9,"p_value":null,"passed":true,"detail":"d"}]})";
+  if (!sets_json.empty()) std::ofstream(dir / "sets.json") << sets_json;
+  ReportOptions ro;
+  ro.out_dir = (dir / "site").string();
+  ro.results_path = (dir / "r.json").string();
+  ro.sample_sets_path = (dir / "sets.json").string();
+  write_report(ro);
+  return slurp(dir / "site" / "kernel-k.html");
+}
+
+// One line of two points each way, one blue-noise point: every drawn point is one of the file's.
+const char* kTinySampleSets =
+    R"({"grid_lines":1,"grid_line_samples":2,"blue_noise":{"seed":1,"u":[[0.25,0.75]]},"cases":[)"
+    R"({"kernel":"k","scalar":"double","config":"c","description":"tiny","expect_no_sample":false,)"
+    R"("grid":[[0.5,0],null,[0.1,0.2,1],[0,0]],"blue":[[0.5,0.5]]}]})";
+
+TEST(Report, SampleSetsAreDrawnFromTheFilesPointsAndNothingElse) {
+  const std::string page = kernel_page_with_sample_sets(work_dir(), kTinySampleSets);
+  // The blue-noise point (0.25, 0.75) in the square, its image (0.5, 0.5) on the disk: centre (420, 144), radius 110.
+  EXPECT_NE(page.find("<circle cx=\"85.00\" cy=\"89.00\""), std::string::npos);
+  EXPECT_NE(page.find("<circle cx=\"475.00\" cy=\"89.00\""), std::string::npos);
+  EXPECT_NE(page.find("1 mapped, 0 declined</text>"), std::string::npos);
+  // The grid: 3 of 4 points mapped, one declined, one outside the cap.
+  EXPECT_NE(page.find("3 mapped, 1 declined, 1 OUTSIDE the cap"), std::string::npos);
+  EXPECT_NE(page.find("k / double / c: grid"), std::string::npos);
+}
+
+TEST(Report, AMissingSampleSetsFileIsReportedWithTheCommandThatWritesIt) {
+  const std::string page = kernel_page_with_sample_sets(work_dir(), "");
+  EXPECT_NE(page.find("sets.json does not exist. Produce it with <code>build/sample_sets --out"), std::string::npos);
+}
+
+TEST(Report, ASampleSetsFileWhoseGridDoesNotMatchItsLineCountIsRefused) {
+  std::string bad = kTinySampleSets;
+  bad.replace(bad.find("\"grid_line_samples\":2"), 23, "\"grid_line_samples\":3");
+  EXPECT_THROW(kernel_page_with_sample_sets(work_dir(), bad), std::runtime_error);
+}
+
+TEST(SampleSets, TheWrittenFileReadsBackAsTheSamplersOwnDirectionsToFourDecimals) {
+  const Registry reg = default_registry();
+  std::vector<const Case*> cases;
+  for (const Case* c : reg.select({"polygon-solid-angle"}, {"triangle"}))
+    if (c->scalar == "double") cases.push_back(c);
+  ASSERT_EQ(cases.size(), 1u);
+  const SampleSets sets = parse_sample_sets(sample_sets::sample_sets_json(cases, "test"));
+  ASSERT_EQ(sets.cases.size(), 1u);
+  const SamplerUnderTest s = cases[0]->make();
+  const auto u = sample_sets::grid_line_points(sets.grid_lines, sets.grid_line_samples);
+  ASSERT_EQ(u.size(), sets.cases[0].grid.size());
+  std::size_t mapped = 0;
+  for (std::size_t i = 0; i < u.size(); ++i) {
+    const auto m = sample_sets::map_point(s, u[i]);
+    ASSERT_EQ(bool(m), sets.cases[0].grid[i].valid) << i;
+    if (!m) continue;
+    ++mapped;
+    EXPECT_NEAR(sets.cases[0].grid[i].x, m->x, 5.0001e-5) << i;
+    EXPECT_NEAR(sets.cases[0].grid[i].y, m->y, 5.0001e-5) << i;
+    EXPECT_EQ(sets.cases[0].grid[i].outside, m->outside) << i;
+  }
+  EXPECT_GT(mapped, u.size() / 2);
 }
