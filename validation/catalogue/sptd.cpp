@@ -111,12 +111,6 @@ template <template <class> class K, class T> void add_sptd(Registry& r, const Sp
 
 // ---- LTC -----------------------------------------------------------------------------------------------------
 
-struct LtcConfig {
-  const char* name;
-  const char* description;
-  LtcPolygonGeometry<Real> g;
-};
-
 PolygonLightGeometry<Real> decentral_rectangle() {
   PolygonLightGeometry<Real> g;
   g.shading.position = Vec3L(0, 0, 0);
@@ -138,6 +132,8 @@ Mat3<Real> mat(Real a, Real b, Real c, Real d, Real e, Real f, Real g, Real h, R
   m << a, b, c, d, e, f, g, h, i;
   return m;
 }
+
+}  // namespace
 
 std::vector<LtcConfig> ltc_configs() {
   // "random": drawn once from test_ltc_mis.cpp's random_m (seed 5), rounded to 4 digits.
@@ -161,6 +157,8 @@ std::vector<LtcConfig> ltc_configs() {
        {straddling_rectangle(), mat(0.3L, 0, -0.6L, 0, 0.3L, 0, 0, 0, 1)}},
   };
 }
+
+namespace {
 
 Real condition_number(const Mat3<Real>& m) {
   const Eigen::JacobiSVD<Mat3<Real>> svd(m);

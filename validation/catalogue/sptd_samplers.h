@@ -4,6 +4,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "warpcheck/catalogue.h"
 #include "warpcheck/validation/sampler.h"
@@ -41,6 +42,14 @@ inline Real ltc_reference_projected_solid_angle(const LtcPolygonGeometry<Real>& 
     t.light.vertices[i] = mi * f.to_local(Vec3L(g.polygon.light.vertices[i] - g.polygon.shading.position));
   return reference_projected_solid_angle(t);
 }
+
+// The registry's LTC configurations (sptd.cpp): a polygon and M, from the identity to near-singular.
+struct LtcConfig {
+  const char* name;
+  const char* description;
+  LtcPolygonGeometry<Real> g;
+};
+std::vector<LtcConfig> ltc_configs();
 
 // LTC sampling of a polygon in scalar T (M in the shading frame Frame<T>::from_z(normal)), with the normalisation
 // check of Eq. 10 against ltc_reference_projected_solid_angle.

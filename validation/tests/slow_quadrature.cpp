@@ -1,12 +1,14 @@
 // The battery's expected counts, KS CDFs and pdf integral (expected_integrals: the grid quadrature, or the
 // nested adaptive one where the grid's two orders disagree) against the nested adaptive quadrature alone, on every
-// registry case, to the accuracy each test needs at 10^7 samples (label "slow": about 20 s per case).
+// registry case, to the accuracy each test needs at 10^7 samples (label "slow": about 20 s per case). The LTC
+// cases' azimuth CDFs are compared with their closed form instead.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <numeric>
 
 #include "battery/tests.h"
+#include "tests/quadrature_fixtures.h"
 #include "warpcheck/validation/registry.h"
 
 using namespace warpcheck::validation;
@@ -24,6 +26,17 @@ std::string gtest_name(const testing::TestParamInfo<std::string>& i) {
   for (char& c : s)
     if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
   return s;
+}
+// An LTC case's azimuth CDF in closed form (quadrature_fixtures.h) instead of the adaptive quadrature's: the latter
+// misses 1.5e-5 of the near-singular lobe's peak (its own error estimate says 0.18), where the closed form and
+// the grid agree to 6e-11.
+void replace_by_closed_form(const Case& c, KsCdfs& ks) {
+  if (c.kernel != "polygon-ltc") return;
+  for (const LtcConfig& l : ltc_configs())
+    if (c.config == l.name) {
+      const std::vector<Real> slabs = ltc_azimuth_slab_masses(l.g, c.make().bounding_cap, ks.xa);
+      for (std::size_t k = 0; k < slabs.size(); ++k) ks.Fa[k + 1] = ks.Fa[k] + slabs[k];
+    }
 }
 }  // namespace
 
@@ -46,7 +59,8 @@ TEST_P(EveryCaseQuadrature, ExpectedCountsAndCdfsMeetTheirBoundsAgainstTheAdapti
   // differences are printed, not required.
   const bool float_rounding = e.quadrature.find("float pdf's rounding") != std::string::npos;
   const std::vector<Real> mass = reference_bin_masses(s, o);
-  const KsCdfs ks = reference_ks_cdfs(s, o);
+  KsCdfs ks = reference_ks_cdfs(s, o);
+  replace_by_closed_form(*c, ks);
   const Real n = Real(o.samples);
   std::vector<Real> expected(mass.size()), error(mass.size());
   for (std::size_t k = 0; k < mass.size(); ++k) expected[k] = n * mass[k], error[k] = n * (e.mass[k] - mass[k]);
