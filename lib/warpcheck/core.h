@@ -14,6 +14,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <type_traits>
 
 namespace warpcheck {
 
@@ -333,8 +334,28 @@ template <class T> void sine_cosine(T x, T& s, T& c) {
   s = sine(x), c = cosine(x);
 }
 
+// 2^e when it is a normal float or double (built from its bits, no library call), else 0.
+template <class T> T normal_power_of_two(int e) {
+  if (e < std::numeric_limits<T>::min_exponent - 1 || e > std::numeric_limits<T>::max_exponent - 1) return T(0);
+  if constexpr (std::is_same_v<T, float>)
+    return std::bit_cast<float>(std::uint32_t(e + 127) << 23);
+  else if constexpr (std::is_same_v<T, double>)
+    return std::bit_cast<double>(std::uint64_t(e + 1023) << 52);
+  else
+    return T(0);
+}
+
+// x * 2^e as std::ldexp gives it: for a normal 2^e one product, whose single rounding (exact unless the result
+// over- or underflows) is ldexp's.
+template <class T> T scale_by_power_of_two(T x, int e) {
+  const T p = normal_power_of_two<T>(e);
+  return p != T(0) ? x * p : std::ldexp(x, e);
+}
+
 // v * 2^e, exact componentwise (std::ldexp) unless a component over- or underflows.
 template <class T> Vec3<T> ldexp(const Vec3<T>& v, int e) {
+  const T p = normal_power_of_two<T>(e);
+  if (p != T(0)) return v * p;
   return Vec3<T>(std::ldexp(v.x(), e), std::ldexp(v.y(), e), std::ldexp(v.z(), e));
 }
 

@@ -112,7 +112,7 @@ template <class T> bool edge_in_plane(const Vec3<T>& e, T err, const Vec3<T>& nh
   std::frexp(e.cwiseAbs().maxCoeff(), &scale);
   const Vec3<T> es = ldexp(e, -scale);
   scaled = es - nhat.dot(es) * nhat;
-  scaled_err = std::ldexp(err, -scale);
+  scaled_err = scale_by_power_of_two(err, -scale);
   return scaled.norm() > scaled_err;
 }
 
@@ -143,14 +143,14 @@ template <class T> Verdict check_vertices(const PolygonLight<T>& p) {
 }
 
 // A nonzero area, wider than the planarity tolerance (else no determined plane), every vertex within that tolerance
-// of the plane. Sets nhat, the unit area vector.
-template <class T> Verdict check_plane(const PolygonLight<T>& p, Vec3<T>& nhat) {
+// of the plane. Sets area2, Newell's vector (polygon_area_vector), and nhat = area2 / |area2|.
+template <class T> Verdict check_plane(const PolygonLight<T>& p, Vec3<T>& area2, Vec3<T>& nhat) {
   T diameter = 0, magnitude = 0;
   for (int i = 0; i < p.count; ++i) {
     magnitude = std::max(magnitude, p.vertices[i].cwiseAbs().maxCoeff());
     for (int j = i + 1; j < p.count; ++j) diameter = std::max(diameter, (p.vertices[i] - p.vertices[j]).norm());
   }
-  const Vec3<T> area2 = polygon_area_vector(p);
+  area2 = polygon_area_vector(p);
   const T area2_norm = area2.norm();
   if (!(area2_norm > T(0)) || !std::isfinite(area2_norm)) return {NoSample::kZeroSize, "zero area"};
   nhat = area2 / area2_norm;
@@ -204,19 +204,26 @@ template <class T> Verdict check_convexity(const PolygonLight<T>& p, const Vec3<
   return {};
 }
 
+// check_polygon (below), also giving Newell's vector of a valid light.
+template <class T>
+NoSample check_polygon_and_area(const PolygonLight<T>& p, std::string* message, T vertex_rounding, Vec3<T>& area2) {
+  Vec3<T> nhat = Vec3<T>::Zero();
+  area2 = Vec3<T>::Zero();
+  Verdict v = check_vertices(p);
+  if (v.ok()) v = check_plane(p, area2, nhat);
+  if (v.ok()) v = check_convexity(p, nhat, vertex_rounding);
+  if (message) *message = v.why;
+  return v.reason;
+}
+
 }  // namespace polygon_check_detail
 
 // kNone for a valid light; otherwise kNonFinite, kZeroSize or kInvalidGeometry, with a message if asked. Each vertex
 // is known to vertex_rounding |V_k|_inf (ltc.h passes its own bound for M^-1 P).
 template <class T> NoSample check_polygon(const PolygonLight<T>& p, std::string* message = nullptr,
                                           T vertex_rounding = kPolygonVertexRounding<T>) {
-  using namespace polygon_check_detail;
-  Vec3<T> nhat = Vec3<T>::Zero();
-  Verdict v = check_vertices(p);
-  if (v.ok()) v = check_plane(p, nhat);
-  if (v.ok()) v = check_convexity(p, nhat, vertex_rounding);
-  if (message) *message = v.why;
-  return v.reason;
+  Vec3<T> area2;
+  return polygon_check_detail::check_polygon_and_area(p, message, vertex_rounding, area2);
 }
 
 // ---- Clipping to the upper hemisphere (Peters 2021 Sec. 3.1) ----
@@ -271,10 +278,13 @@ PolygonView<T> make_polygon_view(const PolygonLightGeometry<T>& g, T vertex_roun
   v.vertex_rounding = vertex_rounding;
   if (!all_finite(g.shading.position)) return v.reason = NoSample::kNonFinite, v;
   if (!all_finite(g.shading.normal)) return v.reason = NoSample::kNonFinite, v;
-  if (const NoSample r = check_polygon(g.light, nullptr, vertex_rounding); r != NoSample::kNone) return v.reason = r, v;
+  Vec3<T> area2;
+  if (const NoSample r = polygon_check_detail::check_polygon_and_area(g.light, nullptr, vertex_rounding, area2);
+      r != NoSample::kNone)
+    return v.reason = r, v;
   if (!normalize_normal(g.shading.normal, v.normal)) return v.reason = NoSample::kBadNormal, v;
   v.frame = Frame<T>::from_z(v.normal);
-  v.plane_normal = safe_normalized(polygon_area_vector(g.light));
+  v.plane_normal = safe_normalized(area2);  // Newell's vector, as polygon_area_vector
   // Signed distance from the centroid (averaging reduces the rounding of a single vertex).
   Vec3<T> centroid = Vec3<T>::Zero();
   for (int i = 0; i < g.light.count; ++i) centroid += g.light.vertices[i] - g.shading.position;

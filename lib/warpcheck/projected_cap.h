@@ -251,7 +251,7 @@ template <class T> int unit_scale_geometry(const SphereLightGeometry<T>& g, Sphe
   std::frexp(r, &er);  // r < 2^er
   out.shading.position = Vec3<T>::Zero();
   out.light.center = ldexp(d, -e);
-  out.light.radius = er - e > 2 ? T(4) : std::max(std::ldexp(r, -e), std::numeric_limits<T>::denorm_min());
+  out.light.radius = er - e > 2 ? T(4) : std::max(scale_by_power_of_two(r, -e), std::numeric_limits<T>::denorm_min());
   return e;
 }
 
@@ -333,7 +333,7 @@ template <class T> ProjectedCapView<T> make_projected_cap_view(const SphereLight
   const int scale_exponent = unit_scale_geometry(g, unit);
   p.sphere = make_sphere_view(unit);
   if (!p.sphere.valid()) return p.reason = p.sphere.reason, p;
-  p.sphere.distance = std::ldexp(p.sphere.distance, scale_exponent);  // |c - x| in the caller's units
+  p.sphere.distance = scale_by_power_of_two(p.sphere.distance, scale_exponent);  // |c - x| in the caller's units
   local_frame(p);
   p.r_y = std::sqrt(p.sphere.sin2_theta_max);
   p.v = p.sphere.cos_theta_max;

@@ -232,6 +232,9 @@ template <class T> void register_all() {
 int main(int argc, char** argv) {
   warpcheck::register_all<float>();
   warpcheck::register_all<double>();
+  benchmark::AddCustomContext("build_type", WARPCHECK_BENCH_BUILD_TYPE);
+  benchmark::AddCustomContext("cxx_flags", WARPCHECK_BENCH_CXX_FLAGS);
+  benchmark::AddCustomContext("compiler", WARPCHECK_BENCH_COMPILER);
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   benchmark::RunSpecifiedBenchmarks();

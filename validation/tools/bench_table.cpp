@@ -3,13 +3,18 @@
 //   scripts/bench.sh                                  (runs the benchmarks, then this tool)
 //   build/bench_table data/bench/results.json [--markdown]
 //
-// Per-sample time t = 1 / items_per_second (CPU time) of each benchmark; the baseline of the same scalar,
+// Per-sample time t = 1 / items_per_second (CPU time) of each benchmark (the median over repetitions when the JSON
+// has them, --benchmark_repetitions); the baseline of the same scalar,
 // configuration and samples-per-light mode ("baseline": reading the random numbers and the geometry only) is
 // subtracted, as the papers do. Ratios:
 //   sphere-projected-cap / sphere-solid-angle   per q_z, 1 and 500 samples per light (target at 500: <= 2)
 //   polygon-projected-solid-angle / polygon-solid-angle   per vertex count, central and decentral (target
 //                                               decentral: <= 4)
 //   sphere-solid-angle / its batch API          per q_z at 500 (speed-up of the batch; target float: >= 3)
+//   every kernel at 1 / at 500 samples per light   per scalar and configuration: the per-light setup's overhead
+//                                               (targets: sphere-solid-angle and the projected caps <= 1.5;
+//                                               polygon solid angle, projected solid angle, Arvo and Urena on
+//                                               triangles and quads <= 2)
 // beside the papers' ratios, computed from the published tables (not measured by us):
 //   Peters & Dachsbacher 2019 Table 2 (offline renderer, ns per sample, baseline row subtracted):
 //     (ours - baseline) / (solid angle - baseline);
@@ -23,8 +28,10 @@
 #include <iostream>
 #include <map>
 #include <optional>
+#include <regex>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace {
 
@@ -55,11 +62,52 @@ std::optional<double> paper_polygon_ratio(bool central, int n, int spl) {
   return (central ? proj_central : proj_decentral)[m][n - 3] / solid[m][n - 3];
 }
 
+// The setup-overhead target of a kernel in a configuration (1 spl / 500 spl), if the issue sets one.
+std::optional<double> setup_target(const std::string& kernel, const std::string& config) {
+  if (kernel == "sphere-solid-angle" || kernel == "sphere-projected-cap" || kernel == "sphere-projected-cap-exact")
+    return 1.5;
+  const bool tri_or_quad = config.ends_with("-3") || config.ends_with("-4");
+  if (tri_or_quad && (kernel == "polygon-solid-angle" || kernel == "polygon-projected-solid-angle" ||
+                      kernel == "baseline-arvo-triangle" || kernel == "baseline-urena-rectangle"))
+    return 2.0;
+  return std::nullopt;
+}
+
 std::string fmt(std::optional<double> v, const char* f = "%.2f") {
   if (!v) return "-";
   char b[32];
   std::snprintf(b, sizeof b, f, *v);
   return b;
+}
+
+// Every kernel's cost per sample at 1 and at 500 samples per light and their ratio (the per-light setup's overhead).
+template <class Net, class Ratio>
+void print_setup_table(const std::map<std::string, double>& t, const Net& net, const Ratio& ratio) {
+  // KERNEL -> SCALAR -> CONFIG, in the JSON's (registration) order of first appearance.
+  std::vector<std::string> kernels;
+  std::map<std::string, std::vector<std::string>> configs;  // SCALAR + "/" + CONFIG per kernel
+  for (const auto& [name, seconds] : t) {
+    const auto a = name.find('/'), b = name.find('/', a + 1), c = name.find("/spl=1", b + 1);
+    if (a == std::string::npos || b == std::string::npos || c == std::string::npos || c + 6 != name.size()) continue;
+    const std::string kernel = name.substr(0, a);
+    if (kernel == "baseline") continue;
+    if (!configs.contains(kernel)) kernels.push_back(kernel);
+    configs[kernel].push_back(name.substr(a + 1, c - a - 1));
+  }
+  std::printf("\nPer-light setup: cost per sample at 1 sample per light / at 500 (both baseline subtracted)\n");
+  std::printf("%-31s %-7s %-12s %10s %10s %8s %7s %6s\n", "kernel", "scalar", "config", "1 spl ns", "500 spl ns",
+              "ratio", "target", "met?");
+  for (const std::string& kernel : kernels)
+    for (const std::string& sc : configs[kernel]) {
+      const std::string scalar = sc.substr(0, sc.find('/')), config = sc.substr(sc.find('/') + 1);
+      const auto one = net(kernel, "/" + sc + "/spl=1"), many = net(kernel, "/" + sc + "/spl=500");
+      const auto r = ratio(one, many);
+      const auto target = setup_target(kernel, config);
+      std::printf("%-31s %-7s %-12s %10s %10s %8s %7s %6s\n", kernel.c_str(), scalar.c_str(), config.c_str(),
+                  fmt(one ? std::optional(*one * 1e9) : std::nullopt).c_str(),
+                  fmt(many ? std::optional(*many * 1e9) : std::nullopt).c_str(), fmt(r).c_str(), fmt(target).c_str(),
+                  target && r ? (*r <= *target ? "yes" : "NO") : "");
+    }
 }
 
 }  // namespace
@@ -72,20 +120,34 @@ int main(int argc, char** argv) {
   std::ifstream in(argv[1]);
   std::stringstream ss;
   ss << in.rdbuf();
+  // Google Benchmark writes a 0/0 counter (declined_fraction's coefficient of variation) as NaN, which is no JSON.
+  const std::string text = std::regex_replace(ss.str(), std::regex(R"(:\s*-?(NaN|nan|inf|Infinity)\b)"), ": null");
   boost::json::value root;
   try {
-    root = boost::json::parse(ss.str());
+    root = boost::json::parse(text);
   } catch (const std::exception& e) {
     std::cerr << "bench_table: cannot parse " << argv[1] << ": " << e.what() << "\n";
     return 2;
   }
-  // name -> seconds per sample
-  std::map<std::string, double> t;
+  // name -> seconds per sample: the median aggregate if there is one, else the (last) single run.
+  std::map<std::string, double> t, median;
   for (const auto& b : root.at("benchmarks").as_array()) {
     const auto& o = b.as_object();
-    if (o.contains("run_type") && o.at("run_type").as_string() != "iteration") continue;
     if (!o.contains("items_per_second")) continue;
-    t[std::string(o.at("name").as_string())] = 1.0 / o.at("items_per_second").to_number<double>();
+    const double seconds = 1.0 / o.at("items_per_second").to_number<double>();
+    const bool aggregate = o.contains("run_type") && o.at("run_type").as_string() == "aggregate";
+    if (!aggregate)
+      t[std::string(o.at("name").as_string())] = seconds;
+    else if (o.at("aggregate_name").as_string() == "median")
+      median[std::string(o.at("run_name").as_string())] = seconds;
+  }
+  for (const auto& [name, seconds] : median) t[name] = seconds;
+  std::string flags = "(not recorded)", build_type = "?", compiler = "?";
+  if (const auto* ctx = root.as_object().if_contains("context")) {
+    auto get = [&](const char* key, std::string& out) {
+      if (const auto* v = ctx->as_object().if_contains(key); v && v->is_string()) out = v->as_string().c_str();
+    };
+    get("cxx_flags", flags), get("build_type", build_type), get("compiler", compiler);
   }
   // KERNEL/SCALAR/CONFIG/spl=S[suffix] minus baseline/SCALAR/CONFIG/spl=S; rest = /SCALAR/CONFIG/spl=S.
   auto net = [&](const std::string& kernel, const std::string& rest,
@@ -99,7 +161,9 @@ int main(int argc, char** argv) {
     return *a / *b;
   };
 
-  std::printf("Per-sample costs (ns, baseline subtracted) and ratios; measured from %s\n\n", argv[1]);
+  std::printf("Per-sample costs (ns, baseline subtracted) and ratios; measured from %s\n", argv[1]);
+  std::printf("Build: %s, %s, flags \"%s\"; %s\n\n", build_type.c_str(), compiler.c_str(), flags.c_str(),
+              median.empty() ? "one run per benchmark" : "median over repetitions");
   std::printf("Projected spherical cap / sphere solid angle (Peters & Dachsbacher 2019 Table 2 configurations)\n");
   std::printf("%-7s %-5s %5s %10s %10s %8s %8s %7s\n", "scalar", "qz", "spl", "solid ns", "proj ns", "ratio", "paper",
               "<=2?");
@@ -143,5 +207,6 @@ int main(int argc, char** argv) {
                   fmt(b ? std::optional(*b * 1e9) : std::nullopt).c_str(), fmt(r).c_str(),
                   std::string(T) == "float" && r ? (*r >= 3 ? "yes" : "NO") : "");
     }
+  print_setup_table(t, net, ratio);
   return 0;
 }
