@@ -2,58 +2,29 @@
 // `warpcheck merge` puts the N shards' files together into the unsharded run's file, bit for bit, with the
 // correction recomputed over all tests (merge_shards, shards.h), and refuses shards that are not the N disjoint,
 // finished parts of one run, naming the files. `warpcheck merge` of worst-case search files works as before.
-#include <fcntl.h>
 #include <gtest/gtest.h>
-#include <spawn.h>
-#include <sys/wait.h>
 
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 #include <limits>
 
+#include "cli_process.h"
 #include "warpcheck/validation/battery.h"
 #include "warpcheck/validation/results.h"
 #include "warpcheck/validation/searches.h"
 #include "warpcheck/validation/shards.h"
 
-extern char** environ;
-
 using namespace warpcheck::validation;
+using namespace warpcheck::test;
 namespace fs = std::filesystem;
 
 namespace {
 
-fs::path warpcheck_cli() {
-  fs::path dir = fs::read_symlink("/proc/self/exe").parent_path();
-  if (!fs::exists(dir / "warpcheck")) dir = dir.parent_path();
-  return dir / "warpcheck";
-}
-
-std::string read_all(const fs::path& p) {
-  std::ifstream f(p, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
-}
-
 // Runs the CLI with args to completion, stdout and stderr to dir/name.{out,err}; returns its exit status.
 int run(const std::vector<std::string>& args, const fs::path& dir, const std::string& name) {
-  std::vector<std::string> all = {warpcheck_cli().string()};
-  all.insert(all.end(), args.begin(), args.end());
-  std::vector<char*> argv;
-  for (auto& a : all) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  posix_spawn_file_actions_t files;
-  posix_spawn_file_actions_init(&files);
-  posix_spawn_file_actions_addopen(&files, 1, (dir / (name + ".out")).c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_addopen(&files, 2, (dir / (name + ".err")).c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  pid_t pid = -1;
-  const int rc = posix_spawn(&pid, argv[0], &files, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&files);
-  if (rc != 0) return -1;
-  int status = 0;
-  waitpid(pid, &status, 0);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  const pid_t pid = start(args, dir, name);
+  return pid > 0 ? exit_status(pid) : -1;
 }
 
 std::vector<std::string> with(std::vector<std::string> a, const std::vector<std::string>& more) {
