@@ -2,7 +2,9 @@
 # A real single-node Slurm cluster on this machine (ctest slurm.single_node, label slow), from Debian's munge,
 # slurmctld and slurmd (WARPCHECK_SLURM=1 scripts/setup.sh installs them), each with its own configuration,
 # key, ports and state in a temporary directory. Through scripts/slurm/submit.sh it submits a battery in 4 shards
-# and a worst-case search in 2 shards, waits for the merge job, and checks that
+# and a worst-case search in 2 shards, requeues (preempts) battery shard 0 once it has finished a case, waits for
+# the merge job, and checks that
+#   - the requeued shard resumed from its file;
 #   - the merged battery file equals an unsharded run of the same cases byte for byte (statistics, p-values,
 #     corrected verdicts), and the report was written from it;
 #   - the merged search's worst case is the best of its shards' and its chains their sum.
@@ -88,21 +90,36 @@ done
 [[ "$state" == idle ]] || { echo "FAIL: the node is '$state', not idle"; tail -20 "$tmp"/slurm*.log; exit 1; }
 echo "cluster up in $(($(date +%s) - start)) s (munged, slurmctld, slurmd: pids ${pids[*]})"
 
-# Eight cases at 10^5 samples in 4 shards; a 3 s search in 2 shards.
+# Twelve cases at 2 10^5 samples in 4 shards of 3; a 3 s search in 2 shards.
 selection=(--kernel sphere-solid-angle --config near --config grazing --config below-horizon
-  --config partly-below-horizon --scalar double --scalar "long double" --samples 100000 --seed 3 --threads 1)
+  --config partly-below-horizon --scalar float --scalar double --scalar "long double" --samples 200000 --seed 3
+  --threads 1)
 search=precision-sphere-solid-angle-double-angle
 "$root/scripts/slurm/submit.sh" --out "$tmp/out" --warpcheck "$exe" --battery-shards 4 --search "$search" \
   --search-shards 2 --seconds 3 --search-args "--seed 5" -- "${selection[@]}" | tee "$tmp/submit.txt"
 merge_job=$(sed -n 's/^merge: job \([0-9]*\).*/\1/p' "$tmp/submit.txt")
-for _ in $(seq 600); do
-  [[ -z "$(squeue -h 2>/dev/null)" ]] && break
-  sleep 1
+battery_job=$(sed -n 's/^battery: job array \([0-9]*\).*/\1/p' "$tmp/submit.txt")
+# Preempt shard 0 as soon as its file holds a case: requeued, the task must resume from that file.
+for _ in $(seq 600); do [[ -s "$tmp/out/battery-shard-0.json" ]] && break; sleep 0.1; done
+scontrol requeue "${battery_job}_0"
+# Slurm delays a requeued job's start (BeginTime); a preempted task on a real cluster waits for a free node.
+for _ in $(seq 50); do
+  scontrol update JobId="${battery_job}_0" StartTime=now 2>/dev/null && break
+  sleep 0.2
 done
+deadline=$((SECONDS + 600))
+while ((SECONDS < deadline)) && [[ -n "$(squeue -h 2>/dev/null)" ]]; do sleep 1; done
 [[ -z "$(squeue -h)" ]] || { echo "FAIL: jobs still queued after 10 min"; squeue; exit 1; }
 echo "jobs done in $(($(date +%s) - start)) s (merge job $merge_job)"
 
 fail=0
+if grep -q "resuming $tmp/out/battery-shard-0.json: [1-9]" "$tmp/out/battery-0.log"; then
+  echo "ok: the requeued shard 0 resumed from its file ($(grep -o 'resuming.*' "$tmp/out/battery-0.log"))"
+else
+  echo "FAIL: the requeued shard 0 did not resume"
+  cat "$tmp/out/battery-0.log"
+  fail=1
+fi
 [[ -f "$tmp/out/battery.json" ]] || { echo "FAIL: no merged battery"; cat "$tmp/out/"*.log; exit 1; }
 "$exe" validate "${selection[@]}" --quiet --json "$tmp/whole.json" >/dev/null || [[ $? -eq 1 ]]
 if cmp -s "$tmp/out/battery.json" "$tmp/whole.json"; then
