@@ -2,13 +2,17 @@
 # Idempotent set-up: installs the Debian packages warpcheck needs (only those missing), configures and builds.
 # Sourced by scripts/battery.sh and scripts/test.sh; can also be run alone. Env: BUILD_DIR (default build),
 # WARPCHECK_CMAKE_ARGS (extra cmake arguments, e.g. -DWARPCHECK_SANITIZE=ON), WARPCHECK_WARNINGS_AS_ERRORS (ON or OFF:
-# -Werror, default ON: the CI build; OFF for a compiler that warns where GCC 12 does not).
+# -Werror, default ON: the CI build; OFF for a compiler that warns where GCC 12 does not), WARPCHECK_SLURM (1: also
+# install munge and Slurm's slurmctld, slurmd and client for the single-node Slurm test, scripts/slurm/; off by
+# default). An argument "--slurm" is WARPCHECK_SLURM=1.
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD_DIR="${BUILD_DIR:-$ROOT/build}"
 
 PACKAGES=(cmake ninja-build g++ libboost1.81-dev libeigen3-dev libopenexr-dev libgtest-dev libbenchmark-dev
-          clang clang-format libclang-rt-14-dev libpng-dev chromium)
+          clang clang-format libclang-rt-14-dev libpng-dev chromium zip unzip)
+[[ "${1:-}" == --slurm ]] && WARPCHECK_SLURM=1
+if [[ "${WARPCHECK_SLURM:-0}" == 1 ]]; then PACKAGES+=(munge slurmctld slurmd slurm-client); fi
 
 missing=()
 for p in "${PACKAGES[@]}"; do

@@ -213,6 +213,18 @@ Correction correction_of(const json::value& v) {
   return c == to_string(Correction::kHolm) ? Correction::kHolm : Correction::kSidak;
 }
 
+ShardOf read_shard(const json::value& v) {
+  if (!v.is_object()) bad("shard is not an object");
+  const json::object& o = v.get_object();
+  ShardOf s;
+  s.index = count(member(o, "index", "shard"), "shard.index");
+  s.count = count(member(o, "count", "shard"), "shard.count");
+  s.cases = count(member(o, "cases", "shard"), "shard.cases");
+  s.case_list = string_of(member(o, "case_list", "shard"), "shard.case_list");
+  if (s.count == 0 || s.index >= s.count) bad("shard.index is not below shard.count");
+  return s;
+}
+
 // A result as {head,"passed":<flag>,tail}: the text on either side of the flag.
 std::pair<std::string, std::string> result_parts(const TestResult& r) {
   std::string head, tail;
@@ -231,6 +243,11 @@ std::string to_json(const BatteryRun& run, ResultTexts* texts) {
   if (run.samples) head["samples"] = *run.samples;
   if (run.seed) head["seed"] = *run.seed;
   if (run.complete) head["complete"] = *run.complete;
+  if (run.shard)
+    head["shard"] = json::object{{"index", run.shard->index},
+                                 {"count", run.shard->count},
+                                 {"cases", run.shard->cases},
+                                 {"case_list", run.shard->case_list}};
   std::string out;
   write(head, out);
   out.pop_back();  // reopen the object for the results, one per line
@@ -259,6 +276,7 @@ BatteryRun parse_battery_json(const std::string& text) {
   if (const auto* v = o.if_contains("samples")) run.samples = count(*v, "samples");
   if (const auto* v = o.if_contains("seed")) run.seed = count(*v, "seed");
   if (const auto* v = o.if_contains("complete")) run.complete = bool_of(*v, "complete");
+  if (const auto* v = o.if_contains("shard")) run.shard = read_shard(*v);
   const json::value& results = member(o, "results", "top level");
   if (!results.is_array()) bad("results is not an array");
   for (const json::value& rv : results.get_array())

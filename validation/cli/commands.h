@@ -22,9 +22,15 @@ int worst_case_main(const std::vector<std::string>& args);
 int merge_main(const std::vector<std::string>& args);
 int report_main(const std::vector<std::string>& args);
 
+// `warpcheck merge` of battery shards (validate.cpp): files and their texts; the merged run to json or stdout.
+int merge_battery(const std::vector<std::string>& files, const std::vector<std::string>& texts,
+                  const std::string& json);
+
 // Argument helpers shared by the subcommands.
 std::uint64_t parse_u64(const std::string& flag, const std::string& value, std::uint64_t min, std::uint64_t max);
 double parse_double(const std::string& flag, const std::string& value, double min, double max);
+// --shard I/N into index I and count N (N >= 1, I < N).
+void parse_shard(const std::string& value, std::uint64_t& index, std::uint64_t& count);
 // Writes text to path atomically (temporary file in the same directory, then rename).
 void write_file_atomically(const std::string& path, const std::string& text);
 

@@ -14,7 +14,7 @@ const warpcheck::cli::Command kCommands[] = {
     {"validate", "run the validation battery", warpcheck::cli::validate_main},
     {"worst-case", "search for the worst-case error of a kernel (resumable, shardable)",
      warpcheck::cli::worst_case_main},
-    {"merge", "combine worst-case results of shards or runs", warpcheck::cli::merge_main},
+    {"merge", "combine worst-case results, or battery shards, into one file", warpcheck::cli::merge_main},
     {"report", "write the HTML report of a battery run", warpcheck::cli::report_main},
 };
 

@@ -7,12 +7,14 @@
 #include <fstream>
 #include <functional>
 #include <limits>
+#include <optional>
 #include <sstream>
 
 #include "commands.h"
 #include "warpcheck/validation/battery.h"
 #include "warpcheck/validation/negative_controls.h"
 #include "warpcheck/validation/registry.h"
+#include "warpcheck/validation/shards.h"
 
 namespace warpcheck::cli {
 
@@ -47,6 +49,13 @@ double parse_double(const std::string& flag, const std::string& value, double mi
   return v;
 }
 
+void parse_shard(const std::string& v, std::uint64_t& index, std::uint64_t& count) {
+  const auto slash = v.find('/');
+  if (slash == std::string::npos) throw UsageError("--shard needs I/N, e.g. 3/8, got '" + v + "'");
+  count = parse_u64("--shard N", v.substr(slash + 1), 1, UINT32_MAX);
+  index = parse_u64("--shard I", v.substr(0, slash), 0, count - 1);
+}
+
 void write_file_atomically(const std::string& path, const std::string& text) {
   const std::string tmp = path + ".tmp." + std::to_string(::getpid());
   {
@@ -71,7 +80,7 @@ const char* kListHelp =
 const char* kValidateHelp =
     "usage: warpcheck validate [--kernel GLOB]... [--config GLOB]... [--scalar GLOB]... [--samples N]\n"
     "                          [--seed S] [--alpha A] [--correction holm|sidak] [--threads N] [--json FILE]\n"
-    "                          [--quiet] [--negative-controls] [--resume]\n"
+    "                          [--quiet] [--negative-controls] [--resume] [--shard I/N]\n"
     "\n"
     "Runs the battery (chi2, ks-radial, ks-azimuth, pdf-integral, pdf-consistency, normalization:*) on every\n"
     "selected kernel and configuration and prints a table: kernel, scalar, config, test, statistic, p-value,\n"
@@ -90,6 +99,11 @@ const char* kValidateHelp =
     "  --quiet           no progress on stderr (see below)\n"
     "  --resume          with --json: keep the cases already in FILE (from a killed run with the same --samples\n"
     "                    and --seed) and run only the others; the correction is recomputed over all of them\n"
+    "  --shard I/N       run only the cases c with c mod N == I of the selection's case list (in 'warpcheck list'\n"
+    "                    order), each with the same seed as in the whole run; the JSON file records the shard.\n"
+    "                    'warpcheck merge' combines the N shards' files into the whole run's, bit for bit, and\n"
+    "                    recomputes the correction over all of them: a shard's verdicts and exit status count\n"
+    "                    only its own tests\n"
     "  --negative-controls  run the deliberately broken samplers instead of the registered kernels (each\n"
     "                    must FAIL; the exit status is then 1 when the battery works)\n"
     "\n"
@@ -155,6 +169,7 @@ struct ValidateArgs {
   Correction corr = Correction::kHolm;
   std::string json;
   bool quiet = false, negative = false, resume = false;
+  std::uint64_t shard_index = 0, shard_count = 0;  // shard_count 0: not sharded
 };
 
 // Parses validate's arguments into v; false when --help was printed instead.
@@ -190,6 +205,8 @@ bool parse_validate_args(const std::vector<std::string>& a, ValidateArgs& v) {
       v.negative = true;
     } else if (f == "--resume") {
       v.resume = true;
+    } else if (f == "--shard") {
+      parse_shard(value(), v.shard_index, v.shard_count);
     } else {
       throw UsageError("unknown option '" + f + "'");
     }
@@ -204,9 +221,10 @@ bool same_case(const TestResult& r, const Case& c) {
 
 // The results of an earlier run (the --json file of a killed or finished run) to continue from; removes their
 // cases from `cases`. The file must come from the same --samples and --seed: mixing sample counts would make
-// the run's verdicts meaningless. Known limitations are the current registry's policy, not the earlier run's:
-// the results of selected cases are re-tagged.
-std::vector<TestResult> results_to_resume(const ValidateArgs& v, std::vector<const Case*>& cases) {
+// the run's verdicts meaningless; and from the same shard of the same case list. Known limitations are the current
+// registry's policy, not the earlier run's: the results of selected cases are re-tagged.
+std::vector<TestResult> results_to_resume(const ValidateArgs& v, const std::optional<ShardOf>& run_shard,
+                                          std::vector<const Case*>& cases) {
   std::ifstream in(v.json);
   std::stringstream text;
   if (in) text << in.rdbuf();
@@ -221,6 +239,14 @@ std::vector<TestResult> results_to_resume(const ValidateArgs& v, std::vector<con
     throw UsageError("cannot resume: '" + v.json + "' was written with --samples " +
                      std::to_string(earlier.samples.value_or(0)) + " --seed " +
                      std::to_string(earlier.seed.value_or(0)) + "; give the same values");
+  if (earlier.shard != run_shard)
+    throw UsageError("cannot resume: '" + v.json + "' holds " +
+                     (earlier.shard ? "shard " + std::to_string(earlier.shard->index) + "/" +
+                                          std::to_string(earlier.shard->count) + " of a run"
+                                    : std::string("no shard")) +
+                     (run_shard ? ", not shard " + std::to_string(v.shard_index) + "/" + std::to_string(v.shard_count) +
+                                      " of this selection"
+                                : ", not this unsharded run"));
   for (TestResult& r : earlier.results)
     for (const Case* c : cases)
       if (same_case(r, *c)) r.known_limitation = c->known_limitation;
@@ -328,6 +354,12 @@ void print_summary(const BatteryRun& run, std::size_t cases, double secs) {
   std::printf("\n%zu tests on %zu cases in %.1f s; alpha %g, %s correction over %zu statistical tests; %zu failed%s\n",
               run.results.size(), cases, secs, run.alpha, to_string(run.correction), run.statistical_tests(), failed,
               known ? (", " + std::to_string(known) + " known-limitation failures").c_str() : "");
+  if (run.shard)
+    std::printf(
+        "shard %llu/%llu of a run of %llu cases: the correction counts this shard's tests only; "
+        "'warpcheck merge' of all shards gives the run's verdicts\n",
+        static_cast<unsigned long long>(run.shard->index), static_cast<unsigned long long>(run.shard->count),
+        static_cast<unsigned long long>(run.shard->cases));
 }
 
 }  // namespace
@@ -339,7 +371,11 @@ int validate_main(const std::vector<std::string>& a) {
   std::vector<const Case*> cases = select_cases(reg, v.sel);
   BatteryRun run;
   run.alpha = v.alpha, run.correction = v.corr, run.samples = v.opt.samples, run.seed = v.opt.seed;
-  if (v.resume) run.results = results_to_resume(v, cases);
+  if (v.shard_count > 0) {
+    run.shard = shard_of(cases, v.shard_index, v.shard_count);
+    cases = shard_cases(cases, v.shard_index, v.shard_count);
+  }
+  if (v.resume) run.results = results_to_resume(v, run.shard, cases);
   if (!v.json.empty()) {  // fail on an unwritable path now, not after an hour of work
     std::ofstream probe(v.json, std::ios::app);
     if (!probe) throw UsageError("cannot write --json file '" + v.json + "'");
@@ -367,6 +403,27 @@ int validate_main(const std::vector<std::string>& a) {
   print_summary(run, cases.size(), std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   if (!v.json.empty()) write_file_atomically(v.json, to_json(run, &texts));
   return all_passed(run.results) ? 0 : 1;
+}
+
+int merge_battery(const std::vector<std::string>& files, const std::vector<std::string>& texts,
+                  const std::string& json) {
+  std::vector<ShardFile> shards;
+  for (std::size_t i = 0; i < files.size(); ++i) try {
+      shards.push_back({files[i], parse_battery_json(texts[i])});
+    } catch (const std::runtime_error& e) {
+      throw std::runtime_error(files[i] + ": " + e.what());
+    }
+  const BatteryRun run = merge_shards(shards);
+  std::size_t failed = 0;
+  for (const TestResult& r : run.results) failed += r.failed();
+  const std::string text = to_json(run);
+  if (json.empty())
+    std::fputs(text.c_str(), stdout);
+  else
+    write_file_atomically(json, text);
+  std::fprintf(stderr, "merged %zu shards: %zu tests; alpha %g, %s correction over %zu statistical tests; %zu failed\n",
+               files.size(), run.results.size(), run.alpha, to_string(run.correction), run.statistical_tests(), failed);
+  return 0;
 }
 
 }  // namespace warpcheck::cli

@@ -1,5 +1,6 @@
 // warpcheck worst-case / warpcheck merge: run a worst-case error search (validation/.../searches.h),
 // resumably and shardably, and combine shard results.
+#include <algorithm>
 #include <csignal>
 #include <cstdio>
 #include <fstream>
@@ -7,6 +8,7 @@
 
 #include "commands.h"
 #include "warpcheck/validation/searches.h"
+#include "warpcheck/validation/shards.h"
 
 namespace warpcheck::cli {
 
@@ -43,9 +45,17 @@ SIGINT/SIGTERM stop the run early; the checkpoint and result are still written. 
 
 const char* kMergeHelp = R"(usage: warpcheck merge FILE... [--json OUT]
 
-Combines results or checkpoints of one search (shards, separate runs): the worst case over all of them, the
-sums of evaluations, chains and seconds. Writes JSON to OUT (atomically) or stdout. Exit status: 0 done,
-1 unreadable or mismatched files, 2 bad arguments.
+Combines files of one kind, told apart by their content, and writes the JSON to OUT (atomically) or stdout:
+
+  worst-case search results or checkpoints of one search (shards of 'warpcheck worst-case --shard', separate
+    runs): the worst case over all of them, the sums of evaluations, chains and seconds;
+  battery results of 'warpcheck validate --shard I/N --json FILE', all N shards of one run: the run's results
+    in its case order, equal bit for bit to an unsharded run's, with the correction (Holm or Sidak) recomputed
+    over all of them; 'warpcheck report --from OUT' reads it. Refused, naming the files: a shard that did not
+    finish, two files with the same shard or case, a missing shard, or shards that differ in --samples,
+    --seed, --alpha, --correction or case selection.
+
+Exit status: 0 done (whatever the merged battery's verdicts), 1 unreadable or mismatched files, 2 bad arguments.
 )";
 
 // The signal handler can only reach a flag with static storage; this is the CLI process's one such flag.
@@ -86,13 +96,6 @@ struct WorstCaseOptions {
   bool list = false, help = false;
 };
 
-void parse_shard(const std::string& v, WorstCaseOptions& o) {
-  const auto slash = v.find('/');
-  if (slash == std::string::npos) throw UsageError("--shard needs I/N, e.g. 3/8, got '" + v + "'");
-  o.shard_count = parse_u64("--shard N", v.substr(slash + 1), 1, UINT32_MAX);
-  o.shard_index = parse_u64("--shard I", v.substr(0, slash), 0, o.shard_count - 1);
-}
-
 WorstCaseOptions parse_worst_case(const std::vector<std::string>& args) {
   WorstCaseOptions o;
   for (std::size_t i = 0; i < args.size(); ++i) {
@@ -125,7 +128,7 @@ WorstCaseOptions parse_worst_case(const std::vector<std::string>& args) {
     else if (a == "--evaluate")
       o.evaluate = value();
     else if (a == "--shard")
-      parse_shard(value(), o);
+      parse_shard(value(), o.shard_index, o.shard_count);
     else
       throw UsageError("unknown option '" + a + "'");
   }
@@ -268,12 +271,26 @@ int merge_main(const std::vector<std::string>& args) {
   }
   if (files.empty()) throw UsageError("no files to merge");
   try {
-    std::vector<SearchRecord> records;
+    std::vector<std::string> texts, battery;
     for (const auto& f : files) {
+      texts.push_back(read_file(f));
       try {
-        records.push_back(record_from_json(read_file(f)));
+        if (is_battery_results(texts.back())) battery.push_back(f);
       } catch (const std::exception& e) {
         throw std::runtime_error(f + ": " + e.what());
+      }
+    }
+    if (battery.size() == files.size()) return merge_battery(files, texts, json);
+    for (const auto& f : files)
+      if (!battery.empty() && std::find(battery.begin(), battery.end(), f) == battery.end())
+        throw std::runtime_error(battery.front() + " holds battery results, " + f +
+                                 " does not: merge files of one kind");
+    std::vector<SearchRecord> records;
+    for (std::size_t i = 0; i < files.size(); ++i) {
+      try {
+        records.push_back(record_from_json(texts[i]));
+      } catch (const std::exception& e) {
+        throw std::runtime_error(files[i] + ": " + e.what());
       }
     }
     SearchRecord m = merge_records(records);

@@ -17,49 +17,14 @@
 #include <sstream>
 #include <thread>
 
+#include "cli_process.h"
 #include "warpcheck/validation/results.h"
 
-extern char** environ;
-
 using namespace warpcheck::validation;
+using namespace warpcheck::test;
 namespace fs = std::filesystem;
 
 namespace {
-
-// The CLI is built into the build root; the test executable runs from build/validation/ or the build root.
-fs::path warpcheck_cli() {
-  fs::path dir = fs::read_symlink("/proc/self/exe").parent_path();
-  if (!fs::exists(dir / "warpcheck")) dir = dir.parent_path();
-  return dir / "warpcheck";
-}
-
-// Starts the CLI with args, stdout and stderr to files in dir; returns its pid.
-pid_t start(const std::vector<std::string>& args, const fs::path& dir, const std::string& name) {
-  std::vector<std::string> all = {warpcheck_cli().string()};
-  all.insert(all.end(), args.begin(), args.end());
-  std::vector<char*> argv;
-  for (auto& a : all) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  posix_spawn_file_actions_t files;
-  posix_spawn_file_actions_init(&files);
-  posix_spawn_file_actions_addopen(&files, 1, (dir / (name + ".out")).c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_addopen(&files, 2, (dir / (name + ".err")).c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  pid_t pid = -1;
-  const int rc = posix_spawn(&pid, argv[0], &files, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&files);
-  return rc == 0 ? pid : -1;
-}
-
-int exit_status(pid_t pid) {
-  int status = 0;
-  waitpid(pid, &status, 0);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-}
-
-std::string read_all(const fs::path& p) {
-  std::ifstream f(p, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
-}
 
 // The file of a running CLI, once it parses (the CLI replaces it atomically, so it always does once it exists).
 std::optional<BatteryRun> peek(const fs::path& p) {

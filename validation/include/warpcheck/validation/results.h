@@ -4,13 +4,14 @@
 // level and correction that judged them. `warpcheck validate --json` writes a BatteryRun with to_json,
 // `--resume` and `warpcheck report` read it back with parse_battery_json. The file:
 //
-//   {"alpha":0.01,"correction":"holm","statistical_tests":m,"samples":N,"seed":S,"complete":true,"results":[
+//   {"alpha":0.01,"correction":"holm","statistical_tests":m,"samples":N,"seed":S,"complete":true,
+//    "shard":{"index":I,"count":K,"cases":C,"case_list":"<16 hex digits>"} (only for a shard),"results":[
 //   {"kernel":..,"scalar":..,"config":..,"test":..,"statistic":x,"p_value":p|null,"passed":b,"detail":..,
 //    "known_limitation":.. (only when set), "map":{"rows":R,"cols":A,"observed":[..],"expected":[..]} (chi2)},
 //   ...
 //   ]}
 //
-// one result per line. samples, seed and complete are present when set; statistical_tests is written for other
+// one result per line. samples, seed, complete and shard are present when set; statistical_tests is written for other
 // readers and recomputed from the results on reading. Numbers are written in the shortest form that reads back
 // to the same double and are read exactly, so a file round-trips bit for bit; a NaN statistic is null,
 // +-infinity is +-1e999 (JSON has no infinity; parsers read 1e999 as infinity).
@@ -44,11 +45,21 @@ struct TestResult {
   bool failed() const { return !passed && known_limitation.empty(); }
 };
 
+// The part of a run a shard file holds (`warpcheck validate --shard I/K`): the cases c with c mod K == I of the
+// run's case list of C cases, identified by a digest of its names (shards.h) so that shards of different
+// selections are not merged.
+struct ShardOf {
+  std::uint64_t index = 0, count = 1, cases = 0;
+  std::string case_list;
+  bool operator==(const ShardOf&) const = default;
+};
+
 struct BatteryRun {
   double alpha = 0.01;  // family-wise significance level of the run
   Correction correction = Correction::kHolm;
   std::optional<std::uint64_t> samples, seed;  // the CLI's --samples and --seed
   std::optional<bool> complete;                // false while the CLI is still running (or was killed)
+  std::optional<ShardOf> shard;                // set when the run is one shard of a larger run
   std::vector<TestResult> results;
 
   // The number of results with a p-value: the m of the correction.
