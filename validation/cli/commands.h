@@ -21,6 +21,7 @@ int validate_main(const std::vector<std::string>& args);
 int worst_case_main(const std::vector<std::string>& args);
 int merge_main(const std::vector<std::string>& args);
 int report_main(const std::vector<std::string>& args);
+int promote_main(const std::vector<std::string>& args);
 
 // Argument helpers shared by the subcommands.
 std::uint64_t parse_u64(const std::string& flag, const std::string& value, std::uint64_t min, std::uint64_t max);
