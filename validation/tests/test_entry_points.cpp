@@ -102,3 +102,19 @@ template <class T> void check_all(int count) {
 TEST(EntryPoints, GeometryOverloadsAgreeWithTheBatterysTraitsBitForBitInFloat) { check_all<float>(4); }
 TEST(EntryPoints, GeometryOverloadsAgreeWithTheBatterysTraitsBitForBitInDouble) { check_all<double>(4); }
 TEST(EntryPoints, GeometryOverloadsAgreeWithTheBatterysTraitsBitForBitInLongDouble) { check_all<long double>(4); }
+
+// The comparison sees an entry point that differs from the trait only in a default argument: one iteration of
+// Peters 2021's Newton-bisection instead of two.
+TEST(EntryPoints, TheComparisonSeesADifferentIterationCount) {
+  int valid = 0, bad = 0;
+  for (const GeometryText& t : random_geometry_texts(1, 0)) {
+    if (t.family != "polygon") continue;
+    const PolygonLightGeometry<double> g = polygon_geometry(t).cast<double>();
+    const auto v = PolygonProjectedSolidAngle<double>::view(g);
+    bad += disagreements<PolygonProjectedSolidAngle<double>>(
+        g, [&](const Vec2<double>& u) { return sample_polygon_projected_solid_angle<double, false>(v, u, 1); },
+        [&](const Vec3<double>& w) { return pdf_polygon_projected_solid_angle(g, w); }, &valid);
+  }
+  EXPECT_GT(valid, 0);
+  EXPECT_GT(bad, 0);
+}
