@@ -249,7 +249,7 @@ Drawn draw_sptd(FuzzedDataProvider& in, SptdBase base) {
     return d;
   const SptdCapGeometry<Real> g = gd.cast<Real>();
   const L rp = g.sptd.pivot.norm();
-  if (rp > 0.999L || !(g.cap.one_minus_cos >= 5e-9L) || g.cap.axis.norm() < 1e-30L ||
+  if (rp > 0.999L || !(g.cap.one_minus_cos >= 5e-9L) || !(g.cap.one_minus_cos <= 2) || g.cap.axis.norm() < 1e-30L ||
       (base == SptdBase::kClampedCosine && g.sptd.base_axis.norm() < 1e-30L))
     return d;
   const bool valid =
@@ -304,6 +304,10 @@ Drawn draw_geometry(Family f, std::uint64_t seed, int index) {
   }
   return first;
 }
+
+// The polygon kernels get two geometries per index, a polygon and a rectangle (which Urena et al. also take):
+// the rectangle's configuration carries this suffix, so that (kernel, scalar, configuration) names one case.
+constexpr const char* kRectangleSuffix = "-rectangle";
 
 std::string config_name(std::uint64_t seed, int index) {
   return "random-s" + std::to_string(seed) + "-" + std::to_string(index);
@@ -424,7 +428,10 @@ std::vector<Case> geometry_text_cases(const std::string& name, const std::string
   return cases;
 }
 
-bool parse_random_config_name(const std::string& name, std::uint64_t* seed, int* index) {
+bool parse_random_config_name(const std::string& full, std::uint64_t* seed, int* index) {
+  const std::string suffix = kRectangleSuffix;
+  const bool rectangle = full.size() > suffix.size() && full.ends_with(suffix);
+  const std::string name = rectangle ? full.substr(0, full.size() - suffix.size()) : full;
   unsigned long long s = 0;
   int i = 0, used = 0;
   if (std::sscanf(name.c_str(), "random-s%llu-%d%n", &s, &i, &used) != 2 || used != int(name.size()) || i < 0)
@@ -449,7 +456,8 @@ void register_random_geometry(Registry& r, std::uint64_t seed, int index) {
     if (!d.accepted) continue;
     const std::string description =
         "random " + d.text.family + " geometry" + (d.tags.empty() ? "" : " (" + d.tags + ")") + ": " + to_text(d.text);
-    for (Case& c : geometry_text_cases(config_name(seed, index), description, d.text)) r.add(std::move(c));
+    const std::string name = config_name(seed, index) + (f == kRectangle ? kRectangleSuffix : "");
+    for (Case& c : geometry_text_cases(name, description, d.text)) r.add(std::move(c));
   }
 }
 

@@ -49,8 +49,11 @@ TEST(RandomGeometries, EveryKernelGetsThemInDoubleAndLongDouble) {
     for (const char* scalar : {"double", "long double"})
       EXPECT_TRUE(find_case(r, k, scalar, "random-s3-0") || find_case(r, k, scalar, "random-s3-1"))
           << k << " " << scalar;
-  for (const Case& c : r.cases())
-    if (c.config.rfind("random-", 0) == 0) EXPECT_NE(c.scalar, "float") << c.kernel << " " << c.config;
+  for (const Case& c : r.cases()) {
+    if (c.config.rfind("random-", 0) == 0) {
+      EXPECT_NE(c.scalar, "float") << c.kernel << " " << c.config;
+    }
+  }
 }
 
 TEST(RandomGeometries, ANameAloneGivesTheSameGeometry) {
@@ -70,6 +73,13 @@ TEST(RandomGeometries, ANameAloneGivesTheSameGeometry) {
   EXPECT_FALSE(find_case(one, "sphere-solid-angle", "double", "random-s5-1"));
 }
 
+TEST(RandomGeometries, EachCaseHasItsOwnName) {
+  const Registry r = default_registry(RandomGeometries{3, 1, {}});
+  std::set<std::string> names;
+  for (const Case& c : r.cases())
+    EXPECT_TRUE(names.insert(c.kernel + "|" + c.scalar + "|" + c.config).second) << c.kernel << " " << c.config;
+}
+
 TEST(RandomGeometries, ADifferentSeedGivesDifferentGeometries) {
   const Registry a = default_registry(RandomGeometries{1, 1, {}}), b = default_registry(RandomGeometries{1, 2, {}});
   const Case* ca = find_case(a, "polygon-solid-angle", "double", "random-s1-0");
@@ -84,7 +94,11 @@ TEST(RandomGeometries, OnlyExactNamesAreRandomConfigurations) {
   EXPECT_TRUE(parse_random_config_name("random-s12-7", &seed, &index));
   EXPECT_EQ(seed, 12u);
   EXPECT_EQ(index, 7);
-  for (const char* bad : {"random-s12-07", "random-s12-7x", "random-12-7", "random-s*-7", "random-s1--1", "near"})
+  EXPECT_TRUE(parse_random_config_name("random-s3-4-rectangle", &seed, &index));
+  EXPECT_EQ(seed, 3u);
+  EXPECT_EQ(index, 4);
+  for (const char* bad : {"random-s12-07", "random-s12-7x", "random-s1-2-rectangular", "-rectangle", "random-12-7",
+                          "random-s*-7", "random-s1--1", "near"})
     EXPECT_FALSE(parse_random_config_name(bad, &seed, &index)) << bad;
 }
 
