@@ -113,7 +113,8 @@ TEST(GeometryText, RoundTripsEveryNumberExactly) {
   EXPECT_THROW(parse_geometry_text("sphere x=1,2,oops"), std::runtime_error);
 }
 
-// A results file with one failing random case: promote writes its geometry under --out, and the registry reads
+// A results file with one failing random case (and a passing one of another family in the same configuration):
+// promote writes the failing case's geometry under --out, and the registry reads
 // that directory as configuration promoted-<config> of every kernel of the family, with the same geometry.
 TEST(Promote, AFailingRandomGeometryBecomesAConfigurationOfItsFamily) {
   const Registry r = default_registry(RandomGeometries{1, 9, {}});
@@ -127,6 +128,11 @@ TEST(Promote, AFailingRandomGeometryBecomesAConfigurationOfItsFamily) {
   failed.kernel = c->kernel, failed.scalar = c->scalar, failed.config = c->config, failed.test = "chi2";
   failed.statistic = 1e3, failed.p_value = 1e-9, failed.passed = false;
   run.results.push_back(failed);
+  // The same configuration's sphere geometry, which passed: not promoted, and not mistaken for the failing one's.
+  const Case* other = find_case(r, "sphere-solid-angle", "double", "random-s9-0");
+  ASSERT_TRUE(other);
+  for (const TestResult& t : other->extras(BatteryOptions{}))
+    if (t.test == "geometry") run.results.push_back(t);
   const fs::path dir = fs::temp_directory_path() / ("warpcheck-promote-" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
@@ -134,12 +140,13 @@ TEST(Promote, AFailingRandomGeometryBecomesAConfigurationOfItsFamily) {
   const std::string cmd = warpcheck_cli().string() + " promote " + (dir / "results.json").string() + " --out " +
                           (dir / "promoted").string() + " > " + (dir / "out.txt").string();
   ASSERT_EQ(std::system(cmd.c_str()), 0);
-  ASSERT_TRUE(fs::exists(dir / "promoted" / "random-s9-0.txt"));
+  ASSERT_TRUE(fs::exists(dir / "promoted" / "random-s9-0-projected-cap.txt"));
+  EXPECT_FALSE(fs::exists(dir / "promoted" / "random-s9-0-sphere.txt"));
   Registry promoted;
   register_promoted_geometries(promoted, (dir / "promoted").string());
   std::set<std::string> kernels;
   for (const Case& p : promoted.cases()) {
-    EXPECT_EQ(p.config, "promoted-random-s9-0");
+    EXPECT_EQ(p.config, "promoted-random-s9-0-projected-cap");
     EXPECT_EQ(geometry_of(p), geometry_of(*c));
     kernels.insert(p.kernel);
   }
