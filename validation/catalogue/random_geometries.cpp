@@ -310,7 +310,7 @@ Drawn draw_geometry(Family f, std::uint64_t seed, int index) {
 constexpr const char* kRectangleSuffix = "-rectangle";
 
 std::string config_name(std::uint64_t seed, int index) {
-  return "random-s" + std::to_string(seed) + "-" + std::to_string(index);
+  return std::string("random-s").append(std::to_string(seed)).append("-").append(std::to_string(index));
 }
 
 // The geometry as the results file's first line of the case: a deterministic result "geometry" whose detail is
@@ -484,7 +484,8 @@ void register_promoted_geometries(Registry& r, const std::string& dir) {
     }
     const GeometryText t = parse_geometry_text(geometry);
     const std::string description = "promoted " + t.family + " geometry (" + origin + "): " + geometry;
-    for (Case& c : geometry_text_cases("promoted-" + path.stem().string(), description, t)) r.add(std::move(c));
+    for (Case& c : geometry_text_cases(std::string("promoted-").append(path.stem().string()), description, t))
+      r.add(std::move(c));
   }
 }
 

@@ -83,11 +83,11 @@ int promote_main(const std::vector<std::string>& a) {
                    r.scalar.c_str(), r.config.c_str(), from.c_str());
       continue;
     }
-    const std::string family = "-" + g->second.substr(0, g->second.find(' '));
+    const std::string family = std::string("-").append(g->second, 0, g->second.find(' '));
     Promotion& p = promote[r.config.ends_with(family) ? r.config : r.config + family];
     p.geometry = g->second;
     p.failures.push_back(r.kernel + " / " + r.scalar + ": " + r.test + " statistic " + std::to_string(r.statistic) +
-                         (r.p_value ? " p " + std::to_string(*r.p_value) : std::string()) +
+                         (r.p_value ? std::string(" p ").append(std::to_string(*r.p_value)) : std::string()) +
                          (r.passed ? " (passed)" : " (failed)"));
   }
   std::filesystem::create_directories(out);
