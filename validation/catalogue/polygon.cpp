@@ -6,6 +6,7 @@
 #include <utility>
 #include <vector>
 
+#include "catalogue/random_geometries.h"
 #include "warpcheck/catalogue.h"
 #include "warpcheck/validation/registry.h"
 
@@ -238,6 +239,18 @@ template <template <class> class K, class T> void add_case(Registry& r, const Po
 }
 
 }  // namespace
+
+std::vector<Case> polygon_geometry_cases(const char* name, const char* description, const PolygonLightGeometry<Real>& g,
+                                         bool rectangle) {
+  Registry r;
+  const PolygonConfig c{name, description, g, rectangle};
+  PolygonKernels::for_each([&]<template <class> class K>() {
+    if (kernel_takes_only_rectangles<K<Real>>() && !c.rectangle) return;
+    add_case<K, double>(r, c);
+    add_case<K, Real>(r, c);
+  });
+  return r.cases();
+}
 
 void register_polygon_kernels(Registry& r) {
   for (const PolygonConfig& c : configs())

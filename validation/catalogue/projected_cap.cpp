@@ -11,6 +11,7 @@
 #include <cmath>
 
 #include "catalogue/projected_cap_configs.h"
+#include "catalogue/random_geometries.h"
 #include "warpcheck/catalogue.h"
 #include "warpcheck/validation/registry.h"
 
@@ -291,6 +292,17 @@ template std::vector<std::pair<Real, Real>> projected_cap_bands<CutDiskInverse::
     const SphereLightGeometry<Real>&);
 template std::vector<std::pair<Real, Real>> projected_cap_bands<CutDiskInverse::kExact>(
     const SphereLightGeometry<Real>&);
+
+std::vector<Case> projected_cap_geometry_cases(const char* name, const char* description,
+                                               const SphereLightGeometry<Real>& g) {
+  std::vector<Case> cases;
+  const ProjectedCapConfig c{name, description, g};
+  ProjectedCapKernels::for_each([&]<template <class> class K>() {
+    cases.push_back(make_case<K, double>(c));
+    cases.push_back(make_case<K, Real>(c));
+  });
+  return cases;
+}
 
 void register_projected_cap_kernels(Registry& r) {
   for (const ProjectedCapConfig& c : projected_cap_configs())

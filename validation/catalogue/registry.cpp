@@ -35,13 +35,15 @@ std::vector<const Case*> Registry::select(const std::vector<std::string>& kernel
   return out;
 }
 
-Registry default_registry() {
+Registry default_registry(const RandomGeometries& random) {
   Registry r;
   // One line per kernel family.
   register_sphere_kernels(r);
   register_polygon_kernels(r);
   register_projected_cap_kernels(r);
   register_sptd_kernels(r);
+  register_promoted_geometries(r, WARPCHECK_SOURCE_DIR "/data/promoted");
+  register_random_geometries(r, random);
   return r;
 }
 

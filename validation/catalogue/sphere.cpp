@@ -1,6 +1,7 @@
 // Sphere-light kernels (catalogue.h's SphereKernels) and their named configurations.
 #include <string_view>
 
+#include "catalogue/random_geometries.h"
 #include "warpcheck/catalogue.h"
 #include "warpcheck/validation/registry.h"
 
@@ -131,6 +132,16 @@ template <template <class> class K, class T> void add_case(Registry& r, const Sp
 }
 
 }  // namespace
+
+std::vector<Case> sphere_geometry_cases(const char* name, const char* description, const SphereLightGeometry<Real>& g) {
+  Registry r;
+  const SphereConfig c{name, description, g};
+  SphereKernels::for_each([&]<template <class> class K>() {
+    add_case<K, double>(r, c);
+    add_case<K, Real>(r, c);
+  });
+  return r.cases();
+}
 
 void register_sphere_kernels(Registry& r) {
   for (const SphereConfig& c : kConfigs)

@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <string_view>
 
+#include "catalogue/random_geometries.h"
 #include "catalogue/sptd_samplers.h"
 #include "warpcheck/validation/registry.h"
 
@@ -183,6 +184,27 @@ template <class T> void add_ltc(Registry& r, const LtcConfig& c) {
 }
 
 }  // namespace
+
+std::vector<Case> sptd_geometry_cases(const char* name, const char* description, const SptdCapGeometry<Real>& g) {
+  Registry r;
+  SptdKernels::for_each([&]<template <class> class K>() {
+    if constexpr (std::is_same_v<typename K<Real>::Geometry, SptdCapGeometry<Real>>) {
+      if (K<Real>::base != g.sptd.base) return;
+      const SptdConfig c{K<Real>::name, name, description, g};
+      add_sptd<K, double>(r, c);
+      add_sptd<K, Real>(r, c);
+    }
+  });
+  return r.cases();
+}
+
+std::vector<Case> ltc_geometry_cases(const char* name, const char* description, const LtcPolygonGeometry<Real>& g) {
+  Registry r;
+  const LtcConfig c{name, description, g};
+  add_ltc<double>(r, c);
+  add_ltc<Real>(r, c);
+  return r.cases();
+}
 
 // Each SPTD configuration names its kernel (one of the cap kernels, with that kernel's base); LTC has its own.
 void register_sptd_kernels(Registry& r) {

@@ -21,6 +21,7 @@ int validate_main(const std::vector<std::string>& args);
 int worst_case_main(const std::vector<std::string>& args);
 int merge_main(const std::vector<std::string>& args);
 int report_main(const std::vector<std::string>& args);
+int promote_main(const std::vector<std::string>& args);
 
 // `warpcheck merge` of battery shards (validate.cpp): files and their texts; the merged run to json or stdout.
 int merge_battery(const std::vector<std::string>& files, const std::vector<std::string>& texts,

@@ -16,6 +16,7 @@ const warpcheck::cli::Command kCommands[] = {
      warpcheck::cli::worst_case_main},
     {"merge", "combine worst-case results, or battery shards, into one file", warpcheck::cli::merge_main},
     {"report", "write the HTML report of a battery run", warpcheck::cli::report_main},
+    {"promote", "turn failing random geometries of a results file into registry data", warpcheck::cli::promote_main},
 };
 
 void usage(std::FILE* out) {

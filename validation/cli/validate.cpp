@@ -74,13 +74,14 @@ void write_file_atomically(const std::string& path, const std::string& text) {
 namespace {
 
 const char* kListHelp =
-    "usage: warpcheck list [--kernel GLOB]... [--config GLOB]...\n"
+    "usage: warpcheck list [--kernel GLOB]... [--config GLOB]... [--random N] [--random-seed S]\n"
     "Lists every registered (kernel, scalar, configuration) with a one-line description of the geometry.\n";
 
 const char* kValidateHelp =
     "usage: warpcheck validate [--kernel GLOB]... [--config GLOB]... [--scalar GLOB]... [--samples N]\n"
     "                          [--seed S] [--alpha A] [--correction holm|sidak] [--threads N] [--json FILE]\n"
-    "                          [--quiet] [--negative-controls] [--resume] [--shard I/N]\n"
+    "                          [--quiet] [--negative-controls] [--resume] [--shard I/N] [--random N]\n"
+    "                          [--random-seed S]\n"
     "\n"
     "Runs the battery (chi2, ks-radial, ks-azimuth, pdf-integral, pdf-consistency, normalization:*) on every\n"
     "selected kernel and configuration and prints a table: kernel, scalar, config, test, statistic, p-value,\n"
@@ -89,6 +90,10 @@ const char* kValidateHelp =
     "  --kernel GLOB     kernels to run (default: all; see 'warpcheck list')\n"
     "  --config GLOB     configurations to run (default: all)\n"
     "  --scalar GLOB     scalar types: float, double, 'long double' (default: all)\n"
+    "  --random N        also N random geometries per kernel family (double and long double), drawn by the\n"
+    "                    fuzz targets' decoders and named random-s<S>-<index>; --config random-s<S>-<index>\n"
+    "                    alone replays one (default 0)\n"
+    "  --random-seed S   seed of the random geometries (default 1)\n"
     "  --samples N       samples per kernel and configuration (default 10000000, at least 1000)\n"
     "  --seed S          seed of every random stream (default 1); the same seed gives the same results\n"
     "  --alpha A         family-wise significance level of the whole run (default 0.01)\n"
@@ -117,13 +122,17 @@ const char* kValidateHelp =
 
 struct Selection {
   std::vector<std::string> kernels, configs, scalars;
+  RandomGeometries random;
 };
 
 // Consumes "--flag value" pairs; returns false if args[i] is not one of the selection flags.
 bool take_selection(const std::vector<std::string>& a, std::size_t& i, Selection& sel) {
   const std::string& f = a[i];
-  if (f != "--kernel" && f != "--config" && f != "--scalar") return false;
+  if (f != "--kernel" && f != "--config" && f != "--scalar" && f != "--random" && f != "--random-seed") return false;
   if (i + 1 >= a.size()) throw UsageError(f + " needs a value");
+  if (f == "--random") return sel.random.count = int(parse_u64(f, a[++i], 0, 100000)), true;
+  if (f == "--random-seed") return sel.random.seed = parse_u64(f, a[++i], 0, ~0ULL), true;
+  if (f == "--config") sel.random.names.push_back(a[i + 1]);  // random-s<S>-<index>: that geometry
   auto& dst = f == "--kernel" ? sel.kernels : f == "--config" ? sel.configs : sel.scalars;
   dst.push_back(a[++i]);
   return true;
@@ -151,7 +160,7 @@ int list_main(const std::vector<std::string>& a) {
     }
     if (!take_selection(a, i, sel)) throw UsageError("unknown option '" + a[i] + "'");
   }
-  const Registry reg = default_registry();
+  const Registry reg = default_registry(sel.random);
   for (const Case* c : select_cases(reg, sel)) {
     std::printf("%-38s %-11s %-26s %s%s%s\n", c->kernel.c_str(), c->scalar.c_str(), c->config.c_str(),
                 c->description.c_str(), c->known_limitation.empty() ? "" : "  [known limitation: ",
@@ -344,8 +353,23 @@ class Progress {
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
 };
 
+// The command that replays each failing random or promoted case alone, with the run's sample count and seed.
+void print_replays(const BatteryRun& run) {
+  std::vector<std::string> printed;
+  for (const TestResult& r : run.results) {
+    if (!r.failed() || (r.config.rfind("random-", 0) != 0 && r.config.rfind("promoted-", 0) != 0)) continue;
+    const std::string cmd = "warpcheck validate --kernel " + r.kernel + " --scalar '" + r.scalar + "' --config " +
+                            r.config + " --samples " + std::to_string(run.samples.value_or(0)) + " --seed " +
+                            std::to_string(run.seed.value_or(0));
+    if (std::find(printed.begin(), printed.end(), cmd) != printed.end()) continue;
+    printed.push_back(cmd);
+    std::printf("replay %s / %s / %s: %s\n", r.kernel.c_str(), r.scalar.c_str(), r.config.c_str(), cmd.c_str());
+  }
+}
+
 void print_summary(const BatteryRun& run, std::size_t cases, double secs) {
   std::fputs(format_table(run.results).c_str(), stdout);
+  print_replays(run);
   std::size_t failed = 0, known = 0;
   for (const auto& r : run.results) {
     failed += r.failed();
@@ -367,7 +391,7 @@ void print_summary(const BatteryRun& run, std::size_t cases, double secs) {
 int validate_main(const std::vector<std::string>& a) {
   ValidateArgs v;
   if (!parse_validate_args(a, v)) return 0;
-  const Registry reg = v.negative ? negative_control_registry() : default_registry();
+  const Registry reg = v.negative ? negative_control_registry() : default_registry(v.sel.random);
   std::vector<const Case*> cases = select_cases(reg, v.sel);
   BatteryRun run;
   run.alpha = v.alpha, run.correction = v.corr, run.samples = v.opt.samples, run.seed = v.opt.seed;

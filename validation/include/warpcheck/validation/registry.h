@@ -6,6 +6,7 @@
 // there.
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
@@ -44,7 +45,23 @@ class Registry {
 // fnmatch-style glob: '*' any run, '?' one character.
 bool glob_match(const std::string& pattern, const std::string& text);
 
-Registry default_registry();
+// Random geometries (validation/catalogue/random_geometries.cpp): `count` per kernel family drawn from `seed`,
+// configurations random-s<seed>-<index>; `names` adds single ones by that name (the replay of a failure).
+struct RandomGeometries {
+  int count = 0;
+  std::uint64_t seed = 1;
+  std::vector<std::string> names;
+};
+
+// The named configurations, the promoted geometries (data/promoted/*.txt, read at run time from the source tree),
+// and the random geometries asked for.
+Registry default_registry(const RandomGeometries& random = {});
+
+void register_random_geometries(Registry& r, const RandomGeometries& random);
+// The geometries of data/promoted/*.txt under `dir`, as configurations promoted-<file name without .txt>.
+void register_promoted_geometries(Registry& r, const std::string& dir);
+// Whether `name` is random-s<seed>-<index>; sets seed and index.
+bool parse_random_config_name(const std::string& name, std::uint64_t* seed, int* index);
 
 // Registrars, one per kernel family.
 void register_sphere_kernels(Registry& r);
