@@ -12,6 +12,7 @@
 #include "commands.h"
 #include "warpcheck/validation/battery.h"
 #include "warpcheck/validation/negative_controls.h"
+#include "warpcheck/validation/power.h"
 #include "warpcheck/validation/registry.h"
 
 namespace warpcheck::cli {
@@ -357,12 +358,14 @@ int validate_main(const std::vector<std::string>& a) {
     if (!v.json.empty()) {  // so far, judged together, and marked incomplete: a killed run keeps what it finished
       BatteryRun partial = run;
       apply_correction(partial.results, run.alpha, run.correction);
+      partial.power = run_power(partial);
       partial.complete = false;
       write_file_atomically(v.json, to_json(partial, &texts));
     }
   }
   progress.end();
   apply_correction(run.results, run.alpha, run.correction);
+  run.power = run_power(run);
   run.complete = true;
   print_summary(run, cases.size(), std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   if (!v.json.empty()) write_file_atomically(v.json, to_json(run, &texts));
