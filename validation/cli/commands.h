@@ -3,6 +3,8 @@
 #include <string>
 #include <vector>
 
+#include "warpcheck/validation/registry.h"
+
 namespace warpcheck::cli {
 
 // Bad arguments: main prints the message and exits with status 2.
@@ -21,10 +23,19 @@ int validate_main(const std::vector<std::string>& args);
 int worst_case_main(const std::vector<std::string>& args);
 int merge_main(const std::vector<std::string>& args);
 int report_main(const std::vector<std::string>& args);
+int plan_main(const std::vector<std::string>& args);
 
 // Argument helpers shared by the subcommands.
 std::uint64_t parse_u64(const std::string& flag, const std::string& value, std::uint64_t min, std::uint64_t max);
 double parse_double(const std::string& flag, const std::string& value, double min, double max);
+// The cases a command runs on: --kernel, --config and --scalar globs (validate.cpp).
+struct Selection {
+  std::vector<std::string> kernels, configs, scalars;
+};
+// Consumes "--flag value" pairs; returns false if args[i] is not one of the selection flags.
+bool take_selection(const std::vector<std::string>& args, std::size_t& i, Selection& sel);
+// The registry's cases the selection matches; UsageError when none does.
+std::vector<const validation::Case*> select_cases(const validation::Registry& reg, const Selection& sel);
 // Writes text to path atomically (temporary file in the same directory, then rename).
 void write_file_atomically(const std::string& path, const std::string& text);
 

@@ -16,6 +16,7 @@ const warpcheck::cli::Command kCommands[] = {
      warpcheck::cli::worst_case_main},
     {"merge", "combine worst-case results of shards or runs", warpcheck::cli::merge_main},
     {"report", "write the HTML report of a battery run", warpcheck::cli::report_main},
+    {"plan", "samples needed to detect a given density error", warpcheck::cli::plan_main},
 };
 
 void usage(std::FILE* out) {

@@ -102,11 +102,8 @@ const char* kValidateHelp =
     "Exit status: 0 when every test passes (documented known limitations excepted), 1 when any fails, 2 on\n"
     "bad arguments.\n";
 
-struct Selection {
-  std::vector<std::string> kernels, configs, scalars;
-};
+}  // namespace
 
-// Consumes "--flag value" pairs; returns false if args[i] is not one of the selection flags.
 bool take_selection(const std::vector<std::string>& a, std::size_t& i, Selection& sel) {
   const std::string& f = a[i];
   if (f != "--kernel" && f != "--config" && f != "--scalar") return false;
@@ -126,8 +123,6 @@ std::vector<const Case*> select_cases(const Registry& reg, const Selection& sel)
   if (out.empty()) throw UsageError("no kernel/configuration matches the selection (see 'warpcheck list')");
   return out;
 }
-
-}  // namespace
 
 int list_main(const std::vector<std::string>& a) {
   Selection sel;

@@ -17,7 +17,7 @@
 //       boost::math::kolmogorov_smirnov_distribution at `level`; eps = min over x of (d + z_target sigma) / |h|
 // The battery rejects when any of its tests does at the correction's first-step level (Holm: alpha / m, Sidak:
 // 1 - (1 - alpha)^(1/m)), so the most powerful single test's eps is what the battery reaches at least: the figure
-// stated is that one, and the test that reaches it. docs/power.md derives the formulas.
+// stated is that one, and the test that reaches it. docs/derivations/power.md derives the formulas.
 #pragma once
 
 #include <cstdint>
