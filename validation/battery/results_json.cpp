@@ -195,13 +195,19 @@ void read_map(const json::value& m, const std::string& where, TestResult& x) {
     bad(where + ": rows x cols does not match the lengths of observed / expected");
 }
 
+// The case a result or a power entry belongs to: its kernel, scalar and config members.
+void read_case(const json::object& o, const std::string& where, std::string& kernel, std::string& scalar,
+               std::string& config) {
+  kernel = string_of(member(o, "kernel", where), where + ".kernel");
+  scalar = string_of(member(o, "scalar", where), where + ".scalar");
+  config = string_of(member(o, "config", where), where + ".config");
+}
+
 TestResult read_result(const json::value& rv, const std::string& where) {
   if (!rv.is_object()) bad(where + " is not an object");
   const json::object& r = rv.get_object();
   TestResult x;
-  x.kernel = string_of(member(r, "kernel", where), where + ".kernel");
-  x.scalar = string_of(member(r, "scalar", where), where + ".scalar");
-  x.config = string_of(member(r, "config", where), where + ".config");
+  read_case(r, where, x.kernel, x.scalar, x.config);
   x.test = string_of(member(r, "test", where), where + ".test");
   x.statistic = number(member(r, "statistic", where), where + ".statistic", true);
   const json::value& p = member(r, "p_value", where);
@@ -218,9 +224,7 @@ CasePower read_power(const json::value& v, const std::string& where) {
   if (!v.is_object()) bad(where + " is not an object");
   const json::object& o = v.get_object();
   CasePower c;
-  c.kernel = string_of(member(o, "kernel", where), where + ".kernel");
-  c.scalar = string_of(member(o, "scalar", where), where + ".scalar");
-  c.config = string_of(member(o, "config", where), where + ".config");
+  read_case(o, where, c.kernel, c.scalar, c.config);
   c.samples = count(member(o, "samples", where), where + ".samples");
   c.level = number(member(o, "level", where), where + ".level");
   c.target = number(member(o, "target", where), where + ".target");

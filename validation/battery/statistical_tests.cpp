@@ -47,6 +47,35 @@ std::vector<Real> reference_bin_masses(const SamplerUnderTest& s, const BatteryO
   return mass;
 }
 
+namespace {
+
+// Pearson's statistic over the cells (expected, observed) into r.statistic, and its p-value from Boost's chi-square
+// survival with cells - 1 degrees of freedom (1 with fewer than two cells); returns the degrees of freedom.
+double pearson(const std::vector<std::pair<Real, Real>>& cells, TestResult& r) {
+  Real chi2 = 0;
+  for (const auto& [e, obs] : cells)
+    if (e > 0) chi2 += (obs - e) * (obs - e) / e;
+  const double dof = double(cells.size()) - 1;
+  r.statistic = double(chi2);
+  if (dof < 1) {
+    r.p_value = 1.0;
+  } else {
+    boost::math::chi_squared dist(dof);
+    r.p_value = double(boost::math::cdf(boost::math::complement(dist, double(chi2))));
+  }
+  return dof;
+}
+
+// Appends the cell of the samples outside the cap, declined or non-finite, compared with the pdf's mass outside;
+// when the pdf puts (almost) no mass there, returns those samples as impossible instead.
+std::uint64_t add_elsewhere_cell(std::vector<std::pair<Real, Real>>& cells, Real expected, std::uint64_t observed) {
+  if (expected < 1e-3L && observed > 0) return observed;
+  cells.emplace_back(expected, Real(observed));
+  return 0;
+}
+
+}  // namespace
+
 TestResult chi_square(const SamplerUnderTest& s, const BatteryOptions& o, const Draws& d, const Expected& ex) {
   const std::vector<Real>& mass = ex.mass;
   TestResult r = make_result(s, "chi2");
@@ -66,10 +95,7 @@ TestResult chi_square(const SamplerUnderTest& s, const BatteryOptions& o, const 
     r.expected.push_back(double(e));
   }
   r.map_rows = o.radial_bins, r.map_cols = o.azimuth_bins;
-  if (expected_elsewhere < 1e-3L && observed_elsewhere > 0)
-    impossible += observed_elsewhere;
-  else
-    bins.emplace_back(expected_elsewhere, Real(observed_elsewhere));
+  impossible += add_elsewhere_cell(bins, expected_elsewhere, observed_elsewhere);
   std::ostringstream detail;
   if (impossible > 0) {
     r.statistic = std::numeric_limits<double>::infinity();
@@ -81,17 +107,10 @@ TestResult chi_square(const SamplerUnderTest& s, const BatteryOptions& o, const 
   }
   std::size_t pooled = 0;
   const std::vector<std::pair<Real, Real>> kept = pool_low_expected(std::move(bins), o.min_expected, pooled);
-  Real chi2 = 0;
-  for (const auto& [e, obs] : kept)
-    if (e > 0) chi2 += (obs - e) * (obs - e) / e;
-  const double dof = double(kept.size()) - 1;
-  r.statistic = double(chi2);
+  const double dof = pearson(kept, r);
   if (dof < 1) {
-    r.p_value = 1.0;
     detail << "fewer than two bins after pooling";
   } else {
-    boost::math::chi_squared dist(dof);
-    r.p_value = double(boost::math::cdf(boost::math::complement(dist, double(chi2))));
     detail << "dof " << dof << ", " << mass.size() << " bins (" << o.radial_bins << "x" << o.azimuth_bins << "), "
            << pooled << " pooled; expected counts by " << ex.quadrature;
   }
@@ -123,24 +142,14 @@ void aggregate_chi_squares(const SamplerUnderTest& s, const BatteryOptions& o, c
     std::size_t impossible = 0;
     for (const auto& [e, obs] : cells)
       if (e <= 0 && obs > 0) impossible += std::size_t(obs);
-    if (expected_elsewhere < 1e-3L && observed_elsewhere > 0)
-      impossible += observed_elsewhere;
-    else
-      cells.emplace_back(expected_elsewhere, Real(observed_elsewhere));
+    impossible += add_elsewhere_cell(cells, expected_elsewhere, observed_elsewhere);
     std::ostringstream detail;
     if (impossible > 0) {
       r.statistic = std::numeric_limits<double>::infinity(), r.p_value = 0.0;
       detail << impossible << " samples where the pdf puts no mass";
     } else {
       std::size_t pooled = 0;
-      Real chi2 = 0;
-      const auto kept = pool_low_expected(std::move(cells), o.min_expected, pooled);
-      for (const auto& [e, obs] : kept)
-        if (e > 0) chi2 += (obs - e) * (obs - e) / e;
-      const double dof = double(kept.size()) - 1;
-      r.statistic = double(chi2);
-      r.p_value =
-          dof < 1 ? 1.0 : double(boost::math::cdf(boost::math::complement(boost::math::chi_squared(dof), r.statistic)));
+      const double dof = pearson(pool_low_expected(std::move(cells), o.min_expected, pooled), r);
       detail << "dof " << dof << ", " << g.rows << "x" << g.cols << " cells of the " << R << "x" << A << " grid, "
              << pooled << " pooled";
     }

@@ -6,20 +6,13 @@
 #include <bit>
 #include <cmath>
 #include <cstdio>
+#include <random>
 
 #include "warpcheck/validation/power.h"
 #include "warpcheck/validation/registry.h"
 
 namespace warpcheck::validation {
 namespace {
-
-std::uint64_t splitmix64(std::uint64_t& x) {
-  std::uint64_t z = (x += 0x9e3779b97f4a7c15ULL);
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-  return z ^ (z >> 31);
-}
-double uniform(std::uint64_t& x) { return double(splitmix64(x) >> 11) * 0x1.0p-53; }
 
 // The sampler with its samples' density multiplied by 1 + eps g(t, phi / 2 pi) (its pdf unchanged), by rejection:
 // a sample is kept with probability (1 + eps g) / (1 + eps bound), else the sampler is asked again at primary
@@ -29,7 +22,8 @@ SamplerUnderTest inject(SamplerUnderTest s, std::function<double(double, double)
   const auto base = s.sample;
   const Cap<Real> cap = s.bounding_cap;
   s.sample = [base, cap, g, eps](double u0, double u1) {
-    std::uint64_t state = std::bit_cast<std::uint64_t>(u0) * 0x9e3779b97f4a7c15ULL ^ std::bit_cast<std::uint64_t>(u1);
+    std::mt19937_64 rng(std::bit_cast<std::uint64_t>(u0) * 0x9e3779b97f4a7c15ULL ^ std::bit_cast<std::uint64_t>(u1));
+    auto uniform = [&rng] { return double(rng() >> 11) * 0x1.0p-53; };
     for (;;) {
       const Sample x = base(u0, u1);
       double keep = 1;
@@ -38,8 +32,8 @@ SamplerUnderTest inject(SamplerUnderTest s, std::function<double(double, double)
         cap_coordinates(cap, x.direction, t, phi);
         keep = (1 + eps * g(double(t), double(phi / kTwoPi<Real>))) / (1 + eps * kBound);
       }
-      if (uniform(state) < keep) return x;
-      u0 = uniform(state), u1 = uniform(state);
+      if (uniform() < keep) return x;
+      u0 = uniform(), u1 = uniform();
     }
   };
   s.sample_block = nullptr;  // the block form would bypass the injected error
