@@ -199,8 +199,11 @@ template <class CellOf> double chi2_eps(const GridMasses& m, const Shape& sh, in
 // Massey's bound for a KS test whose CDF (sub-interval masses `mass`) moves by `delta` per unit eps.
 double ks_eps(const std::vector<double>& mass, const std::vector<double>& delta, std::uint64_t n, double level,
               double target) {
-  const double d = boost::math::quantile(
-      boost::math::complement(boost::math::kolmogorov_smirnov_distribution<double>(double(n)), level));
+  thread_local std::map<std::pair<std::uint64_t, double>, double> critical;  // per (n, level), as above
+  double& d = critical[{n, level}];
+  if (d == 0)
+    d = boost::math::quantile(
+        boost::math::complement(boost::math::kolmogorov_smirnov_distribution<double>(double(n)), level));
   const double z = boost::math::quantile(boost::math::normal(), target);
   double F = 0, h = 0, best = kInf;
   for (std::size_t j = 0; j + 1 < mass.size(); ++j) {
