@@ -192,7 +192,9 @@ template <class CellOf> double chi2_eps(const GridMasses& m, const Shape& sh, in
   for (const auto& [e, x] : kept)
     if (e > 0) lambda1 += double(x * x / e);
   const double dof = double(kept.size()) - 1;
-  if (dof < 1 || !(lambda1 > 0)) return kInf;
+  // Cells whose change is rounding (below 1e-12 of the mass per unit eps, lambda1 / n below 1e-24): an
+  // alternative this test does not see, as a radial one for the columns.
+  if (dof < 1 || !(lambda1 > 1e-24 * double(n))) return kInf;
   return std::sqrt(critical_non_centrality(dof, level, target) / lambda1);
 }
 
@@ -208,7 +210,7 @@ double ks_eps(const std::vector<double>& mass, const std::vector<double>& delta,
   double F = 0, h = 0, best = kInf;
   for (std::size_t j = 0; j + 1 < mass.size(); ++j) {
     F += mass[j], h += delta[j];
-    if (std::abs(h) > 0)
+    if (std::abs(h) > 1e-12)  // beyond rounding, as for the chi-square cells
       best = std::min(best, (d + z * std::sqrt(std::max(0.0, F * (1 - F)) / double(n))) / std::abs(h));
   }
   return best;
