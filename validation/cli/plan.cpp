@@ -25,7 +25,8 @@ const char* kPlanHelp =
     "  wedge   the first column of the chi-square grid (1/32 of the azimuth) too dense by EPS\n"
     "The statistical tests are judged at the first-step level of the correction over M tests (default 6, the\n"
     "tests of one case; give a whole run's count to plan for it). The figures come from the non-central\n"
-    "chi-square and the KS asymptotics on the case's expected counts (docs/derivations/power.md), and name the test that\n"
+    "chi-square and the KS asymptotics on the case's expected counts (docs/derivations/power.md), and name the test "
+    "that\n"
     "reaches the error first.\n";
 
 struct PlanArgs {
@@ -83,10 +84,11 @@ int plan_main(const std::vector<std::string>& a) {
     const GridMasses g = grid_masses(s, p.opt);
     for (Alternative alt : p.alternatives) {
       const std::uint64_t n = samples_needed(g, alt, p.eps, p.alpha, p.corr, p.tests);
-      std::string test = "-";
+      std::string test = "-";  // the most powerful test at n
+      double best = p.eps;
       if (n > 0)
         for (const TestPower& t : test_power(g, alt, n, level))
-          if (t.eps <= p.eps) test = t.test;
+          if (t.eps <= best) test = t.test, best = t.eps;
       std::printf("%-38s %-11s %-24s %-11s %10.3g %14s  %s\n", c->kernel.c_str(), c->scalar.c_str(), c->config.c_str(),
                   to_string(alt), p.eps, n > 0 ? std::to_string(n).c_str() : "never", test.c_str());
     }

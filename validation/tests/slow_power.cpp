@@ -1,6 +1,7 @@
 // The power figures (power.h) against the battery itself (label "slow"): a correct sampler with each standard
 // alternative injected at the predicted eps is rejected, over 100 fixed seeds, in 90% of runs by the test the
-// figure names, within three binomial standard deviations (sqrt(0.9 * 0.1 / 100) = 3%).
+// figure names, within three binomial standard deviations (sqrt(0.9 * 0.1 / 100) = 3%), when that test is a
+// chi-square; in at least 90% - 9% when it is KS, whose figure rests on a lower bound of the power (power.h).
 #include <gtest/gtest.h>
 
 #include <bit>
@@ -78,7 +79,12 @@ TEST(PowerSimulation, EachAlternativeInjectedAtItsPredictedSizeIsRejectedInNinet
                  f.alternative.c_str(), f.eps, f.test.c_str(), by_test, kSeeds, by_battery);
     RecordProperty(f.alternative + "_rejected_by_test", by_test);
     RecordProperty(f.alternative + "_rejected_by_battery", by_battery);
-    EXPECT_NEAR(by_test, 90, 9) << f.alternative << " at eps " << f.eps << " by " << f.test;
+    // A chi-square figure is the non-central chi-square's 0.9 quantile: 90 +- 9. A KS figure is Massey's lower bound
+    // of the power: at least 90 - 9 (a smooth tilt is rejected in about 99 of 100 runs at its KS figure).
+    if (f.test.rfind("ks-", 0) == 0)
+      EXPECT_GE(by_test, 81) << f.alternative << " at eps " << f.eps << " by " << f.test;
+    else
+      EXPECT_NEAR(by_test, 90, 9) << f.alternative << " at eps " << f.eps << " by " << f.test;
     EXPECT_GE(by_battery, by_test);
   }
 }

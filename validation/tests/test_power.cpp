@@ -6,8 +6,13 @@
 #include <boost/math/distributions/kolmogorov_smirnov.hpp>
 #include <boost/math/distributions/non_central_chi_squared.hpp>
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <regex>
+#include <string>
 
 #include "warpcheck/validation/power.h"
+#include "warpcheck/validation/registry.h"
 
 namespace warpcheck::validation {
 namespace {
@@ -115,6 +120,36 @@ TEST(Power, SamplesNeededIsTheSmallestCountWhoseBestTestReachesTheError) {
   // lambda grows as n eps^2: ten times the error needs about a hundredth of the samples.
   const std::uint64_t n10 = samples_needed(g, Alternative::kRegion, 1e-2, 0.01, Correction::kHolm, 6);
   EXPECT_NEAR(double(n) / double(n10), 100, 5);
+}
+
+// `warpcheck plan` prints, per case, what samples_needed gives on the case's bin masses from the battery's own
+// quadrature (one case, ~5 s).
+TEST(Power, ThePlanCommandPrintsTheSamplesNeededForTheCase) {
+  namespace fs = std::filesystem;
+  const fs::path cli = fs::read_symlink("/proc/self/exe").parent_path().parent_path() / "warpcheck";
+  ASSERT_TRUE(fs::exists(cli)) << "build the warpcheck executable";
+  const std::string command = cli.string() +
+                              " plan --kernel sphere-solid-angle --scalar double --config near --error 0.01"
+                              " --alternative region --threads 2";
+  FILE* pipe = ::popen(command.c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string out;
+  char buf[4096];
+  for (std::size_t k; (k = std::fread(buf, 1, sizeof buf, pipe)) > 0;) out.append(buf, k);
+  ASSERT_EQ(::pclose(pipe), 0) << out;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(out, m, std::regex("near +region +0.01 +(\\d+)  (\\S+)"))) << out;
+  const Registry reg = default_registry();
+  const auto cases = reg.select({"sphere-solid-angle"}, {"near"});
+  const Case* c = nullptr;
+  for (const Case* x : cases)
+    if (x->scalar == "double") c = x;
+  ASSERT_NE(c, nullptr);
+  BatteryOptions o;
+  o.threads = 2;
+  const GridMasses g = grid_masses(c->make(), o);
+  EXPECT_EQ(std::stoull(m[1]), samples_needed(g, Alternative::kRegion, 0.01, 0.01, Correction::kHolm, 6));
+  EXPECT_EQ(m[2], "chi2-rings");
 }
 
 TEST(Power, ARunsFiguresRoundTripThroughItsJson) {

@@ -15,6 +15,7 @@
 //   ks-radial, ks-azimuth: Massey's bound, P(D > d) >= P(|F_n(x) - F(x)| > d) at any one x, with F_n(x) normal of
 //       mean F(x) + eps h(x) and variance F(1 - F) / n (h the CDF's change per unit eps); d the critical value of
 //       boost::math::kolmogorov_smirnov_distribution at `level`; eps = min over x of (d + z_target sigma) / |h|
+//       (a lower bound of the power: a KS figure errs on the large side; slow_power.cpp measures by how much)
 // The battery rejects when any of its tests does at the correction's first-step level (Holm: alpha / m, Sidak:
 // 1 - (1 - alpha)^(1/m)), so the most powerful single test's eps is what the battery reaches at least: the figure
 // stated is that one, and the test that reaches it. docs/derivations/power.md derives the formulas.
