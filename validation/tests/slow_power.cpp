@@ -9,8 +9,8 @@
 #include <cstdio>
 #include <random>
 
+#include "tests/power_fixtures.h"
 #include "warpcheck/validation/power.h"
-#include "warpcheck/validation/registry.h"
 
 namespace warpcheck::validation {
 namespace {
@@ -44,13 +44,7 @@ SamplerUnderTest inject(SamplerUnderTest s, std::function<double(double, double)
 TEST(PowerSimulation, EachAlternativeInjectedAtItsPredictedSizeIsRejectedInNinetyPercentOfRuns) {
   constexpr int kSeeds = 100;
   constexpr double kAlpha = 0.01;
-  const Registry reg = default_registry();
-  const auto cases = reg.select({"sphere-solid-angle"}, {"near"});
-  const Case* c = nullptr;
-  for (const Case* x : cases)
-    if (x->scalar == "double") c = x;
-  ASSERT_NE(c, nullptr);
-  const SamplerUnderTest base = c->make();
+  const SamplerUnderTest base = uniform_cone_case();
   BatteryOptions o;
   o.samples = 100'000;
   std::vector<std::uint64_t> seeds;

@@ -11,8 +11,8 @@
 #include <regex>
 #include <string>
 
+#include "tests/power_fixtures.h"
 #include "warpcheck/validation/power.h"
-#include "warpcheck/validation/registry.h"
 
 namespace warpcheck::validation {
 namespace {
@@ -139,15 +139,9 @@ TEST(Power, ThePlanCommandPrintsTheSamplesNeededForTheCase) {
   ASSERT_EQ(::pclose(pipe), 0) << out;
   std::smatch m;
   ASSERT_TRUE(std::regex_search(out, m, std::regex("near +region +0.01 +(\\d+)  (\\S+)"))) << out;
-  const Registry reg = default_registry();
-  const auto cases = reg.select({"sphere-solid-angle"}, {"near"});
-  const Case* c = nullptr;
-  for (const Case* x : cases)
-    if (x->scalar == "double") c = x;
-  ASSERT_NE(c, nullptr);
   BatteryOptions o;
   o.threads = 2;
-  const GridMasses g = grid_masses(c->make(), o);
+  const GridMasses g = grid_masses(uniform_cone_case(), o);
   EXPECT_EQ(std::stoull(m[1]), samples_needed(g, Alternative::kRegion, 0.01, 0.01, Correction::kHolm, 6));
   EXPECT_EQ(m[2], "chi2-rings");
 }
