@@ -827,6 +827,44 @@ std::string results_table(const std::vector<const TestResult*>& rs) {
   return p.str();
 }
 
+// A power figure as the smallest relative error caught: "0.21%", "not seen" (no test sees the alternative), "n/a"
+// (not defined for the case).
+std::string eps_text(const PowerFigure& f) {
+  if (std::isnan(f.eps)) return "n/a";
+  if (std::isinf(f.eps)) return "not seen";
+  return num(100 * f.eps, 2) + "%";
+}
+
+const CasePower* power_of(const BatteryRun& run, const std::string& k, const std::string& sc, const std::string& cf) {
+  for (const CasePower& c : run.power)
+    if (c.kernel == k && c.scalar == sc && c.config == cf) return &c;
+  return nullptr;
+}
+
+// The kernel page's power table: per case, the smallest relative density error of each alternative the battery
+// rejects with probability 0.9 at the run's sample count and level (power.h).
+std::string power_table(const std::string& k, const BatteryRun& run) {
+  std::ostringstream p;
+  p << "<h2 id=\"power\">Power</h2><p class=\"muted\">The smallest relative density error the battery rejects with "
+       "probability 0.9 at the run's sample count and the correction's first-step level, per standard alternative: "
+       "region (the innermost 10% of the mass too dense), tilt (a smooth radial tilt), wedge (the first column "
+       "of the grid too dense); and the test that reaches it.</p><table><tr><th>scalar</th><th>config</th>"
+       "<th>samples</th><th>level</th><th>region</th><th>tilt</th><th>wedge</th></tr>";
+  bool any = false;
+  for (const CasePower& c : run.power) {
+    if (c.kernel != k) continue;
+    any = true;
+    p << "<tr><td>" << html_escape(c.scalar) << "</td><td>" << html_escape(c.config) << "</td><td>" << c.samples
+      << "</td><td>" << num(c.level, 3) << "</td>";
+    for (const PowerFigure& f : c.figures)
+      p << "<td>" << eps_text(f) << (f.test.empty() ? "" : " <span class=\"muted\">" + html_escape(f.test) + "</span>")
+        << "</td>";
+    p << "</tr>";
+  }
+  p << "</table>\n";
+  return any ? p.str() : "";
+}
+
 void write_kernel_page(const std::string& k, const std::vector<const TestResult*>& rs, const BatteryRun& run,
                        const ReportOptions& opt, const SampleSets* sets, ReportSummary& sum) {
   const fs::path out(opt.out_dir);
@@ -838,7 +876,7 @@ void write_kernel_page(const std::string& k, const std::vector<const TestResult*
   p << "<div class=\"banner " << (kf ? "bad" : "good") << "\">"
     << (kf ? std::to_string(kf) + " test(s) FAILED" : "all tests passed (or are documented known limitations)")
     << "</div>\n"
-    << results_table(rs) << "<h2>chi2 maps</h2>\n";
+    << results_table(rs) << power_table(k, run) << "<h2>chi2 maps</h2>\n";
   // Failing maps first: that is where a reader looks.
   std::vector<const TestResult*> maps;
   for (const TestResult* r : rs)
@@ -891,15 +929,18 @@ std::string run_summary(const BatteryRun& run, const ReportOptions& opt, const R
 }
 
 // The pass/fail matrix: one row per kernel x scalar x configuration, one column per test.
-std::string matrix(const Grouped& g) {
+std::string matrix(const Grouped& g, const BatteryRun& run) {
   std::ostringstream x;
   x << "<h2 id=\"matrix\">Pass/fail matrix</h2>\n<p class=\"muted\">Cells: p-value for statistical tests (judged "
        "together at alpha with the correction above), the statistic (relative error) for deterministic ones. "
        "Legend: <span style=\"background:#d8f0d8\">pass</span>, <span style=\"background:#e0302a;color:#fff\">"
        "FAIL</span>, <span style=\"background:#ffd27a\">fail, documented known limitation (striped)</span>, "
        "<span style=\"border:2px dashed #c88a00\">pass on a known-limitation case</span>. Hover a cell for its "
-       "detail; click a kernel for its page.</p>\n<table><tr><th>kernel</th><th>scalar</th><th>config</th>";
+       "detail; click a kernel for its page. Power: the smallest relative density error rejected with probability "
+       "0.9 (region: the innermost 10% of the mass too dense; tilt: a smooth radial tilt; wedge: a thin azimuthal "
+       "wedge too dense).</p>\n<table><tr><th>kernel</th><th>scalar</th><th>config</th>";
   for (const auto& t : g.tests) x << "<th>" << html_escape(t) << "</th>";
+  if (!run.power.empty()) x << "<th>power: region</th><th>tilt</th><th>wedge</th>";
   x << "</tr>\n";
   for (const std::string& k : g.kernels) {
     const std::vector<const TestResult*>& rs = g.by_kernel.at(k);
@@ -924,6 +965,12 @@ std::string matrix(const Grouped& g) {
           << "\"><a href=\"" << kernel_page(k) << "#" << result_anchor(*hit) << "\">" << cell_value(*hit)
           << "</a></td>";
       }
+      if (const CasePower* c = run.power.empty() ? nullptr : power_of(run, k, sc, cf))
+        for (const PowerFigure& f : c->figures)
+          x << "<td class=\"power\" title=\"" << html_escape(f.test.empty() ? "" : "by " + f.test) << "\">"
+            << eps_text(f) << "</td>";
+      else if (!run.power.empty())
+        x << "<td class=\"absent\">&middot;</td><td class=\"absent\">&middot;</td><td class=\"absent\">&middot;</td>";
       x << "</tr>\n";
     }
   }
@@ -937,7 +984,7 @@ void write_index(const BatteryRun& run, const ReportOptions& opt, const Grouped&
   x << "<p><a href=\"#matrix\">matrix</a> | <a href=\"#claims\">paper vs ours</a> | <a href=\"#worst\">worst cases</a>"
        " | <a href=\"#fuzz\">fuzz</a> | <a href=\"#bench\">benchmarks</a> | <a href=\"#geometry-maps\">maps over "
        "geometry</a></p>\n"
-    << matrix(g);
+    << matrix(g, run);
   if (opt.data_dir.empty()) {
     x << "<h2 id=\"claims\">Data</h2>" << not_run("no data directory given", "warpcheck report --data data ...")
       << "<span id=\"worst\"></span><span id=\"fuzz\"></span><span id=\"bench\"></span><span "

@@ -65,6 +65,7 @@ std::vector<TestResult> run_seed(const SamplerUnderTest& s, const BatteryOptions
   const Draws d = draw(s, o, p.expected.ks.xr, p.expected.ks.xa);
   out.push_back(chi_square(s, o, d, p.expected));
   ks_tests(s, p.expected.ks, d, out);
+  aggregate_chi_squares(s, o, d, p.expected, out);
   out.push_back(pdf_integral(s, o, p.expected, p.outside.get()));
   const std::vector<TestResult>& independent = p.independent.get();
   out.insert(out.end(), independent.begin(), independent.end());

@@ -51,6 +51,14 @@ json::object result_tail(const TestResult& r) {
   return o;
 }
 
+json::object power_value(const CasePower& c) {
+  json::array figures;
+  for (const PowerFigure& f : c.figures)
+    figures.push_back(json::object{{"alternative", f.alternative}, {"eps", number_or_null(f.eps)}, {"test", f.test}});
+  return json::object{{"kernel", c.kernel}, {"scalar", c.scalar}, {"config", c.config}, {"samples", c.samples},
+                      {"level", c.level},   {"target", c.target}, {"figures", figures}};
+}
+
 // Compact JSON of v; doubles in the shortest form std::from_chars reads back exactly, +-infinity as +-1e999.
 void write(const json::value& v, std::string& out) {
   if (v.is_object()) {
@@ -187,13 +195,19 @@ void read_map(const json::value& m, const std::string& where, TestResult& x) {
     bad(where + ": rows x cols does not match the lengths of observed / expected");
 }
 
+// The case a result or a power entry belongs to: its kernel, scalar and config members.
+void read_case(const json::object& o, const std::string& where, std::string& kernel, std::string& scalar,
+               std::string& config) {
+  kernel = string_of(member(o, "kernel", where), where + ".kernel");
+  scalar = string_of(member(o, "scalar", where), where + ".scalar");
+  config = string_of(member(o, "config", where), where + ".config");
+}
+
 TestResult read_result(const json::value& rv, const std::string& where) {
   if (!rv.is_object()) bad(where + " is not an object");
   const json::object& r = rv.get_object();
   TestResult x;
-  x.kernel = string_of(member(r, "kernel", where), where + ".kernel");
-  x.scalar = string_of(member(r, "scalar", where), where + ".scalar");
-  x.config = string_of(member(r, "config", where), where + ".config");
+  read_case(r, where, x.kernel, x.scalar, x.config);
   x.test = string_of(member(r, "test", where), where + ".test");
   x.statistic = number(member(r, "statistic", where), where + ".statistic", true);
   const json::value& p = member(r, "p_value", where);
@@ -204,6 +218,27 @@ TestResult read_result(const json::value& rv, const std::string& where) {
     x.known_limitation = string_of(*k, where + ".known_limitation");
   if (const auto* m = r.if_contains("map")) read_map(*m, where + ".map", x);
   return x;
+}
+
+CasePower read_power(const json::value& v, const std::string& where) {
+  if (!v.is_object()) bad(where + " is not an object");
+  const json::object& o = v.get_object();
+  CasePower c;
+  read_case(o, where, c.kernel, c.scalar, c.config);
+  c.samples = count(member(o, "samples", where), where + ".samples");
+  c.level = number(member(o, "level", where), where + ".level");
+  c.target = number(member(o, "target", where), where + ".target");
+  const json::value& figures = member(o, "figures", where);
+  if (!figures.is_array()) bad(where + ".figures is not an array");
+  for (const json::value& fv : figures.get_array()) {
+    const std::string at = where + ".figures[" + std::to_string(c.figures.size()) + "]";
+    if (!fv.is_object()) bad(at + " is not an object");
+    const json::object& f = fv.get_object();
+    c.figures.push_back({string_of(member(f, "alternative", at), at + ".alternative"),
+                         string_of(member(f, "test", at), at + ".test"),
+                         number(member(f, "eps", at), at + ".eps", true)});
+  }
+  return c;
 }
 
 Correction correction_of(const json::value& v) {
@@ -262,7 +297,16 @@ std::string to_json(const BatteryRun& run, ResultTexts* texts) {
     out += r.passed ? "true" : "false";
     out += after;
   }
-  out += "\n]}\n";
+  out += "\n]";
+  if (!run.power.empty()) {
+    out += ",\"power\":[";
+    for (std::size_t i = 0; i < run.power.size(); ++i) {
+      out += i ? ",\n" : "\n";
+      write(power_value(run.power[i]), out);
+    }
+    out += "\n]";
+  }
+  out += "}\n";
   return out;
 }
 
@@ -281,6 +325,11 @@ BatteryRun parse_battery_json(const std::string& text) {
   if (!results.is_array()) bad("results is not an array");
   for (const json::value& rv : results.get_array())
     run.results.push_back(read_result(rv, "results[" + std::to_string(run.results.size()) + "]"));
+  if (const auto* p = o.if_contains("power")) {
+    if (!p->is_array()) bad("power is not an array");
+    for (const json::value& cv : p->get_array())
+      run.power.push_back(read_power(cv, "power[" + std::to_string(run.power.size()) + "]"));
+  }
   return run;
 }
 

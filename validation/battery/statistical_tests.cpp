@@ -1,5 +1,6 @@
 // The battery's statistical tests (tests.h): chi-square on an equal-area grid over the bounding cap with
-// expected counts by quadrature, and Kolmogorov-Smirnov on the two marginals in the cap's frame.
+// expected counts by quadrature, chi-square on aggregates of that grid (its rings, its columns, a coarse grid),
+// and Kolmogorov-Smirnov on the two marginals in the cap's frame.
 #include <algorithm>
 #include <boost/math/distributions/chi_squared.hpp>
 #include <boost/math/distributions/kolmogorov_smirnov.hpp>
@@ -12,6 +13,29 @@
 
 namespace warpcheck::validation::battery {
 
+std::vector<std::pair<Real, Real>> pool_low_expected(std::vector<std::pair<Real, Real>> cells, double min_expected,
+                                                     std::size_t& pooled) {
+  // Every cell expected to hold fewer than min_expected samples joins one pool; if the pool is still too small,
+  // it is folded into the smallest regular cell.
+  std::sort(cells.begin(), cells.end());
+  Real pool_e = 0, pool_x = 0;
+  pooled = 0;
+  std::vector<std::pair<Real, Real>> kept;
+  for (const auto& c : cells) {
+    if (c.first < min_expected)
+      pool_e += c.first, pool_x += c.second, ++pooled;
+    else
+      kept.push_back(c);
+  }
+  if (pool_e > 0 || pool_x > 0) {
+    if (pool_e >= min_expected || kept.empty())
+      kept.emplace_back(pool_e, pool_x);
+    else
+      kept.front().first += pool_e, kept.front().second += pool_x;
+  }
+  return kept;
+}
+
 std::vector<Real> reference_bin_masses(const SamplerUnderTest& s, const BatteryOptions& o) {
   const int R = o.radial_bins, A = o.azimuth_bins;
   std::vector<Real> mass(std::size_t(R) * A);
@@ -22,6 +46,35 @@ std::vector<Real> reference_bin_masses(const SamplerUnderTest& s, const BatteryO
   });
   return mass;
 }
+
+namespace {
+
+// Pearson's statistic over the cells (expected, observed) into r.statistic, and its p-value from Boost's chi-square
+// survival with cells - 1 degrees of freedom (1 with fewer than two cells); returns the degrees of freedom.
+double pearson(const std::vector<std::pair<Real, Real>>& cells, TestResult& r) {
+  Real chi2 = 0;
+  for (const auto& [e, obs] : cells)
+    if (e > 0) chi2 += (obs - e) * (obs - e) / e;
+  const double dof = double(cells.size()) - 1;
+  r.statistic = double(chi2);
+  if (dof < 1) {
+    r.p_value = 1.0;
+  } else {
+    boost::math::chi_squared dist(dof);
+    r.p_value = double(boost::math::cdf(boost::math::complement(dist, double(chi2))));
+  }
+  return dof;
+}
+
+// Appends the cell of the samples outside the cap, declined or non-finite, compared with the pdf's mass outside;
+// when the pdf puts (almost) no mass there, returns those samples as impossible instead.
+std::uint64_t add_elsewhere_cell(std::vector<std::pair<Real, Real>>& cells, Real expected, std::uint64_t observed) {
+  if (expected < 1e-3L && observed > 0) return observed;
+  cells.emplace_back(expected, Real(observed));
+  return 0;
+}
+
+}  // namespace
 
 TestResult chi_square(const SamplerUnderTest& s, const BatteryOptions& o, const Draws& d, const Expected& ex) {
   const std::vector<Real>& mass = ex.mass;
@@ -42,10 +95,7 @@ TestResult chi_square(const SamplerUnderTest& s, const BatteryOptions& o, const 
     r.expected.push_back(double(e));
   }
   r.map_rows = o.radial_bins, r.map_cols = o.azimuth_bins;
-  if (expected_elsewhere < 1e-3L && observed_elsewhere > 0)
-    impossible += observed_elsewhere;
-  else
-    bins.emplace_back(expected_elsewhere, Real(observed_elsewhere));
+  impossible += add_elsewhere_cell(bins, expected_elsewhere, observed_elsewhere);
   std::ostringstream detail;
   if (impossible > 0) {
     r.statistic = std::numeric_limits<double>::infinity();
@@ -55,40 +105,57 @@ TestResult chi_square(const SamplerUnderTest& s, const BatteryOptions& o, const 
     r.detail = detail.str();
     return r;
   }
-  // Pool every bin expected to hold fewer than min_expected samples into one; if the pool is still too
-  // small, fold it into the smallest regular bin.
-  std::sort(bins.begin(), bins.end());
-  Real pool_e = 0, pool_o = 0;
   std::size_t pooled = 0;
-  std::vector<std::pair<Real, Real>> kept;
-  for (const auto& b : bins) {
-    if (b.first < o.min_expected)
-      pool_e += b.first, pool_o += b.second, ++pooled;
-    else
-      kept.push_back(b);
-  }
-  if (pool_e > 0 || pool_o > 0) {
-    if (pool_e >= o.min_expected || kept.empty())
-      kept.emplace_back(pool_e, pool_o);
-    else
-      kept.front().first += pool_e, kept.front().second += pool_o;
-  }
-  Real chi2 = 0;
-  for (const auto& [e, obs] : kept)
-    if (e > 0) chi2 += (obs - e) * (obs - e) / e;
-  const double dof = double(kept.size()) - 1;
-  r.statistic = double(chi2);
+  const std::vector<std::pair<Real, Real>> kept = pool_low_expected(std::move(bins), o.min_expected, pooled);
+  const double dof = pearson(kept, r);
   if (dof < 1) {
-    r.p_value = 1.0;
     detail << "fewer than two bins after pooling";
   } else {
-    boost::math::chi_squared dist(dof);
-    r.p_value = double(boost::math::cdf(boost::math::complement(dist, double(chi2))));
     detail << "dof " << dof << ", " << mass.size() << " bins (" << o.radial_bins << "x" << o.azimuth_bins << "), "
            << pooled << " pooled; expected counts by " << ex.quadrature;
   }
   r.detail = detail.str();
   return r;
+}
+
+std::vector<GridAggregate> grid_aggregates(int radial_bins, int azimuth_bins) {
+  return {{"chi2-rings", radial_bins, 1},
+          {"chi2-columns", 1, azimuth_bins},
+          {"chi2-coarse", std::min(4, radial_bins), std::min(8, azimuth_bins)}};
+}
+
+void aggregate_chi_squares(const SamplerUnderTest& s, const BatteryOptions& o, const Draws& d, const Expected& ex,
+                           std::vector<TestResult>& out) {
+  const int R = o.radial_bins, A = o.azimuth_bins;
+  const Real n = Real(o.samples);
+  const Real inside = std::accumulate(ex.mass.begin(), ex.mass.end(), Real(0));
+  const Real expected_elsewhere = std::max<Real>(0, n * (1 - inside));
+  const std::uint64_t observed_elsewhere = d.outside + d.declined + d.non_finite;
+  for (const GridAggregate& g : grid_aggregates(R, A)) {
+    TestResult r = make_result(s, g.test);
+    std::vector<std::pair<Real, Real>> cells(std::size_t(g.rows) * std::size_t(g.cols), {0, 0});
+    for (int ri = 0; ri < R; ++ri)
+      for (int ai = 0; ai < A; ++ai) {
+        auto& c = cells[std::size_t(g.cell(ri, ai, R, A))];
+        c.first += n * ex.mass[std::size_t(ri * A + ai)], c.second += Real(d.counts[std::size_t(ri * A + ai)]);
+      }
+    std::size_t impossible = 0;
+    for (const auto& [e, obs] : cells)
+      if (e <= 0 && obs > 0) impossible += std::size_t(obs);
+    impossible += add_elsewhere_cell(cells, expected_elsewhere, observed_elsewhere);
+    std::ostringstream detail;
+    if (impossible > 0) {
+      r.statistic = std::numeric_limits<double>::infinity(), r.p_value = 0.0;
+      detail << impossible << " samples where the pdf puts no mass";
+    } else {
+      std::size_t pooled = 0;
+      const double dof = pearson(pool_low_expected(std::move(cells), o.min_expected, pooled), r);
+      detail << "dof " << dof << ", " << g.rows << "x" << g.cols << " cells of the " << R << "x" << A << " grid, "
+             << pooled << " pooled";
+    }
+    r.detail = detail.str();
+    out.push_back(std::move(r));
+  }
 }
 
 namespace {

@@ -56,6 +56,25 @@ std::vector<Real> reference_bin_masses(const SamplerUnderTest& s, const BatteryO
 KsCdfs reference_ks_cdfs(const SamplerUnderTest& s, const BatteryOptions& o);
 
 TestResult chi_square(const SamplerUnderTest& s, const BatteryOptions& o, const Draws& d, const Expected& e);
+// Sorts (expected, x) cells by expected count and pools every cell expected to hold fewer than min_expected
+// samples, x summed with them (x: the observed count, or an alternative's change of the expected count); a pool
+// still below min_expected joins the smallest regular cell. `pooled`: how many cells were pooled.
+std::vector<std::pair<Real, Real>> pool_low_expected(std::vector<std::pair<Real, Real>> cells, double min_expected,
+                                                     std::size_t& pooled);
+// A coarser partition of the R x A chi-square grid: bin (ring r, column a) joins cell
+// (r * rows / R) * cols + a * cols / A. Tested by chi-square with the same outside cell and pooling as chi2:
+// an error spread coherently over many bins (a ring too dense, a wedge, a smooth tilt) adds up in few cells, where
+// the 512-bin statistic spreads it over 511 degrees of freedom.
+struct GridAggregate {
+  const char* test;
+  int rows, cols;
+  int cell(int r, int a, int R, int A) const { return (r * rows / R) * cols + a * cols / A; }
+};
+// chi2-rings (R x 1), chi2-columns (1 x A), chi2-coarse (4 x 8).
+std::vector<GridAggregate> grid_aggregates(int radial_bins, int azimuth_bins);
+// Appends one result per grid aggregate, from the same draws and bin masses as chi2.
+void aggregate_chi_squares(const SamplerUnderTest& s, const BatteryOptions& o, const Draws& d, const Expected& e,
+                           std::vector<TestResult>& out);
 // Appends ks-radial and ks-azimuth, from the draws' counts per slab between c's nodes (drawn with c.xr and c.xa).
 void ks_tests(const SamplerUnderTest& s, const KsCdfs& c, const Draws& d, std::vector<TestResult>& out);
 

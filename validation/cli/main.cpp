@@ -17,6 +17,7 @@ const warpcheck::cli::Command kCommands[] = {
     {"merge", "combine worst-case results, or battery shards, into one file", warpcheck::cli::merge_main},
     {"report", "write the HTML report of a battery run", warpcheck::cli::report_main},
     {"promote", "turn failing random geometries of a results file into registry data", warpcheck::cli::promote_main},
+    {"plan", "samples needed to detect a given density error", warpcheck::cli::plan_main},
 };
 
 void usage(std::FILE* out) {

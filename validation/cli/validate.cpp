@@ -13,6 +13,7 @@
 #include "commands.h"
 #include "warpcheck/validation/battery.h"
 #include "warpcheck/validation/negative_controls.h"
+#include "warpcheck/validation/power.h"
 #include "warpcheck/validation/registry.h"
 #include "warpcheck/validation/shards.h"
 
@@ -120,12 +121,8 @@ const char* kValidateHelp =
     "Exit status: 0 when every test passes (documented known limitations excepted), 1 when any fails, 2 on\n"
     "bad arguments.\n";
 
-struct Selection {
-  std::vector<std::string> kernels, configs, scalars;
-  RandomGeometries random;
-};
+}  // namespace
 
-// Consumes "--flag value" pairs; returns false if args[i] is not one of the selection flags.
 bool take_selection(const std::vector<std::string>& a, std::size_t& i, Selection& sel) {
   const std::string& f = a[i];
   if (f != "--kernel" && f != "--config" && f != "--scalar" && f != "--random" && f != "--random-seed") return false;
@@ -148,8 +145,6 @@ std::vector<const Case*> select_cases(const Registry& reg, const Selection& sel)
   if (out.empty()) throw UsageError("no kernel/configuration matches the selection (see 'warpcheck list')");
   return out;
 }
-
-}  // namespace
 
 int list_main(const std::vector<std::string>& a) {
   Selection sel;
@@ -417,12 +412,14 @@ int validate_main(const std::vector<std::string>& a) {
     if (!v.json.empty()) {  // so far, judged together, and marked incomplete: a killed run keeps what it finished
       BatteryRun partial = run;
       apply_correction(partial.results, run.alpha, run.correction);
+      partial.power = run_power(partial);
       partial.complete = false;
       write_file_atomically(v.json, to_json(partial, &texts));
     }
   }
   progress.end();
   apply_correction(run.results, run.alpha, run.correction);
+  run.power = run_power(run);
   run.complete = true;
   print_summary(run, cases.size(), std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   if (!v.json.empty()) write_file_atomically(v.json, to_json(run, &texts));

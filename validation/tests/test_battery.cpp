@@ -205,7 +205,8 @@ TEST(Battery, AcceptsAnExactUniformConeAndReportsEveryTest) {
   const auto r = validate(uniform_cone(), o);
   std::vector<std::string> tests;
   for (const auto& x : r) tests.push_back(x.test);
-  EXPECT_EQ(tests, (std::vector<std::string>{"chi2", "ks-radial", "ks-azimuth", "pdf-integral", "pdf-consistency"}));
+  EXPECT_EQ(tests, (std::vector<std::string>{"chi2", "ks-radial", "ks-azimuth", "chi2-rings", "chi2-columns",
+                                             "chi2-coarse", "pdf-integral", "pdf-consistency"}));
   EXPECT_TRUE(all_passed(r)) << format_table(r);
 }
 

@@ -22,6 +22,11 @@ TEST_P(NegativeControl, IsRejectedAtTheDefaultSampleCountWithPBelowOneInAMillion
   for (const auto& x : r)
     if (x.p_value) min_p = std::min(min_p, *x.p_value);
   EXPECT_LT(min_p, 1e-6) << s.kernel << "\n" << format_table(r);
+  // A coherent error (a tenth of the support 1% too dense) adds up in the ring aggregate, which the 512-bin
+  // chi-square (p 3.4e-5) and KS (1.3e-11) see only faintly.
+  if (s.kernel == "negative-control:pdf-1pct-high-on-tenth") {
+    EXPECT_LT(min_p, 1e-12) << format_table(r);
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(EveryControl, NegativeControl, ::testing::Range(0, int(negative_controls().size())),

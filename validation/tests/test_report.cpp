@@ -10,6 +10,7 @@
 #include <atomic>
 #include <boost/json.hpp>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <future>
@@ -22,6 +23,7 @@
 #include "tools/sample_sets.h"
 #include "warpcheck/validation/battery.h"
 #include "warpcheck/validation/negative_controls.h"
+#include "warpcheck/validation/power.h"
 #include "warpcheck/validation/registry.h"
 
 namespace fs = std::filesystem;
@@ -158,6 +160,7 @@ const Fixture& fixture() {
         all.insert(all.end(), r.begin(), r.end());
       }
     apply_correction(all, run.alpha, run.correction);
+    run.power = run_power(run);
     std::ofstream(x.results) << to_json(run);
     // A data directory with a fuzz summary, a worst case with a history and the committed geometry maps; no
     // claims, no benchmarks (those sections must say "not run").
@@ -290,6 +293,24 @@ TEST(Report, FailingNegativeControlIsRedInTheMatrixAndListedFirst) {
   EXPECT_NE(index.find("Not run: no Google Benchmark JSON"), std::string::npos);
   EXPECT_NE(index.find("fuzz_sphere-solid-angle_double"), std::string::npos);
   EXPECT_NE(index.find("history of example"), std::string::npos);
+}
+
+TEST(Report, EveryCaseShowsItsPowerFiguresBesideItsVerdicts) {
+  const Fixture& f = fixture();
+  const BatteryRun run = parse_battery_json(slurp(f.results));
+  ASSERT_EQ(run.power.size(), 2u);  // the sphere case and the control
+  const std::string index = slurp(f.site / "index.html");
+  const auto matrix = index.find("id=\"matrix\"");
+  ASSERT_NE(index.find("<th>power: region</th><th>tilt</th><th>wedge</th>", matrix), std::string::npos);
+  const std::string page = slurp(f.site / ("kernel-" + safe_name(f.control) + ".html"));
+  ASSERT_NE(page.find("id=\"power\""), std::string::npos);
+  for (const CasePower& c : run.power)
+    for (const PowerFigure& x : c.figures) {
+      ASSERT_TRUE(std::isfinite(x.eps)) << x.alternative;
+      char text[64];  // the cell as the matrix writes it: the test in its title, eps in percent to 2 digits
+      std::snprintf(text, sizeof text, "title=\"by %s\">%.2g%%</td>", x.test.c_str(), 100 * x.eps);
+      EXPECT_NE(index.find(text, matrix), std::string::npos) << c.kernel << " " << text;
+    }
 }
 
 // A report from a one-result run and the given data directory; returns its index.html.

@@ -132,6 +132,49 @@ TEST(ChiSquareKnownAnswers, ASampleWhereThePdfPutsNoMassGivesPZero) {
   EXPECT_EQ(*empty_bin.p_value, 0.0) << empty_bin.detail;
 }
 
+// The grid aggregates on a hand-made 2 x 2 grid of n = 1000 samples: masses 1/8, 1/8 (ring 0), 1/4, 1/4 (ring 1),
+// 1/4 outside the cap; counts 140, 140, 230, 240, 250 outside. Slips caught: a bin joining the wrong ring or column,
+// the outside cell left out, dof from the grid instead of the cells.
+std::vector<TestResult> aggregates_of_2x2() {
+  SamplerUnderTest s;
+  s.kernel = "hand-made";
+  BatteryOptions o;
+  o.samples = 1000, o.radial_bins = 2, o.azimuth_bins = 2;
+  battery::Draws d;
+  d.n = 1000, d.counts = {140, 140, 230, 240}, d.outside = 250;
+  battery::Expected e;
+  e.mass = {0.125L, 0.125L, 0.25L, 0.25L};
+  std::vector<TestResult> out;
+  battery::aggregate_chi_squares(s, o, d, e, out);
+  return out;
+}
+
+TEST(ChiSquareKnownAnswers, TheRingAggregateSumsEachRingAndSeesACoherentExcessWithFewerDegreesOfFreedom) {
+  // Rings (expected, observed): (250, 280), (500, 470), outside (250, 250): chi2 = 900/250 + 900/500 = 5.4, dof 2,
+  // p = e^-2.7 = 0.067; the full grid's chi2 of the same counts is 5.6 with dof 4 (p = 0.23).
+  const std::vector<TestResult> r = aggregates_of_2x2();
+  ASSERT_EQ(r.size(), 3u);
+  EXPECT_EQ(r[0].test, "chi2-rings");
+  EXPECT_NEAR(r[0].statistic, 5.4, 1e-12);
+  EXPECT_NEAR(*r[0].p_value, chi2_survival_dof2(5.4), 1e-12) << r[0].detail;
+  const TestResult full = chi_square_of(1000, {0.125L, 0.125L, 0.25L, 0.25L}, {140, 140, 230, 240}, 250);
+  EXPECT_NEAR(full.statistic, 5.6, 1e-12);
+  EXPECT_LT(*r[0].p_value, *full.p_value / 3);
+}
+
+TEST(ChiSquareKnownAnswers, TheColumnAggregateSumsEachColumnAndTheCoarseGridKeepsAGridSmallerThanItself) {
+  // Columns: (375, 370), (375, 380), outside (250, 250): chi2 = 25/375 + 25/375 = 2/15, dof 2. The coarse grid
+  // (at most 4 x 8) of a 2 x 2 grid is the grid itself: chi2 = 225/125 + 225/125 + 400/250 + 100/250 = 5.6, dof 4.
+  const std::vector<TestResult> r = aggregates_of_2x2();
+  ASSERT_EQ(r.size(), 3u);
+  EXPECT_EQ(r[1].test, "chi2-columns");
+  EXPECT_NEAR(r[1].statistic, 2.0 / 15, 1e-12);
+  EXPECT_NEAR(*r[1].p_value, chi2_survival_dof2(2.0 / 15), 1e-12) << r[1].detail;
+  EXPECT_EQ(r[2].test, "chi2-coarse");
+  EXPECT_NEAR(r[2].statistic, 5.6, 1e-12);
+  EXPECT_NEAR(*r[2].p_value, chi2_survival_dof4(5.6), 1e-12) << r[2].detail;
+}
+
 // ---- Kolmogorov-Smirnov ---------------------------------------------------------------------------------------
 // Slips caught: a one-sided D (F - i/n or i/n - F without the absolute value); the count at a node taken before
 // adding its slab (the empirical CDF's left limit); n taken as the samples in the slabs instead of every sample
@@ -289,7 +332,8 @@ TEST(CorrectionKnownAnswers, TheReportedStatisticalTestCountIsTheNumberOfPValues
 }
 
 // The same count as the CLI reports it: `warpcheck validate` prints "... correction over M statistical tests", M the
-// p-values in its JSON file, three per case (chi2, ks-radial, ks-azimuth); four cases of 2000 samples (~1 s).
+// p-values in its JSON file, six per case (chi2, ks-radial, ks-azimuth, chi2-rings, chi2-columns, chi2-coarse); four
+// cases of 2000 samples (~1 s).
 TEST(CorrectionKnownAnswers, TheCliSummaryCountsEveryPValueOfTheRunInItsCorrection) {
   namespace fs = std::filesystem;
   // The CLI is built into the build root, the test executable into build/validation/.
@@ -315,7 +359,7 @@ TEST(CorrectionKnownAnswers, TheCliSummaryCountsEveryPValueOfTheRunInItsCorrecti
   std::size_t p_values = 0;
   for (const TestResult& r : run.results) p_values += r.p_value.has_value();
   EXPECT_EQ(std::stoul(m[1]), 4u);
-  EXPECT_EQ(p_values, 3 * 4u);
+  EXPECT_EQ(p_values, 6 * 4u);
   EXPECT_EQ(std::stoul(m[2]), p_values);
 }
 
@@ -430,9 +474,9 @@ TEST(CalibrationKnownAnswers, CorrectSamplersGiveUniformPValuesAtFixedSeeds) {
     for (const std::vector<TestResult>& run : run_battery_seeds(s, o, seeds))
       for (const TestResult& r : run)
         if (r.p_value) p_by_test[r.test].push_back(*r.p_value);
-  ASSERT_EQ(p_by_test.size(), 3u);
-  // Three tests of 200 p-values, each at 1e-3: a correct battery fails this check for some seed set with
-  // probability at most 3e-3 (and, the seeds being fixed, then always; this one passes).
+  ASSERT_EQ(p_by_test.size(), 6u);
+  // Six tests of 200 p-values, each at 1e-3: a correct battery fails this check for some seed set with
+  // probability at most 6e-3 (and, the seeds being fixed, then always; this one passes).
   for (const auto& [test, p] : p_by_test) {
     EXPECT_EQ(p.size(), samplers.size() * kSeeds);
     EXPECT_GT(uniformity_p_value(p), 1e-3) << test;

@@ -5,6 +5,9 @@
 //                 long double adaptive quadrature of the pdf; low-expected bins pooled; p from
 //                 boost::math::chi_squared. A sample outside the bounding cap, or declined, where the pdf
 //                 gives no mass is impossible under the null hypothesis: p = 0.
+//   chi2-rings, chi2-columns, chi2-coarse  the same counts and expected counts summed over the grid's rings, its
+//                 columns and a 4 x 8 coarse grid, with the same outside cell and pooling: a coherent error (a ring
+//                 or wedge too dense, a smooth tilt) adds up in few cells instead of spreading over 511 dof
 //   ks-radial     Kolmogorov-Smirnov on t = (1 - cos theta) / (1 - cos theta_max) in the cap's frame
 //   ks-azimuth    Kolmogorov-Smirnov on phi / 2 pi in the cap's frame; both CDFs from quadrature of the pdf
 //                 (not renormalised: a pdf that integrates to 1.001 is a wrong CDF), p from
@@ -15,7 +18,7 @@
 //   normalization:<what>  relative error of each declared Normalization (deterministic)
 // Statistical tests (those with a p-value) are judged together by apply_correction: one significance level
 // alpha for the whole run, Sidak or Holm corrected across all its statistical tests. The results and their
-// JSON file: results.h.
+// JSON file: results.h; the power of the statistical tests against standard alternatives: power.h.
 #pragma once
 
 #include <cstdint>

@@ -9,11 +9,16 @@
 //   {"kernel":..,"scalar":..,"config":..,"test":..,"statistic":x,"p_value":p|null,"passed":b,"detail":..,
 //    "known_limitation":.. (only when set), "map":{"rows":R,"cols":A,"observed":[..],"expected":[..]} (chi2)},
 //   ...
+//   ],"power":[
+//   {"kernel":..,"scalar":..,"config":..,"samples":N,"level":a,"target":0.9,
+//    "figures":[{"alternative":"region","eps":e|null,"test":..},...]},
+//   ...
 //   ]}
 //
-// one result per line. samples, seed, complete and shard are present when set; statistical_tests is written for other
-// readers and recomputed from the results on reading. Numbers are written in the shortest form that reads back
-// to the same double and are read exactly, so a file round-trips bit for bit; a NaN statistic is null,
+// one result (and one case's power) per line; "power" is absent when there is none. samples, seed, complete and shard
+// are present when set; statistical_tests is written for other readers and recomputed from the results on reading.
+// Numbers are written in the shortest form that reads back to the same double and are read exactly, so a file
+// round-trips bit for bit; a NaN statistic is null,
 // +-infinity is +-1e999 (JSON has no infinity; parsers read 1e999 as infinity).
 #pragma once
 
@@ -54,6 +59,22 @@ struct ShardOf {
   bool operator==(const ShardOf&) const = default;
 };
 
+// The smallest relative density error of one standard alternative (power.h) that the battery rejects with
+// probability `target` at a run's sample count and first-step corrected level: eps, and the test that reaches it.
+// eps is +infinity when no test sees the alternative and NaN when the alternative is not defined for the case
+// (a wedge without mass).
+struct PowerFigure {
+  std::string alternative, test;
+  double eps = 0;
+};
+// The power figures of one case of a run, computed from its chi2 result's expected counts.
+struct CasePower {
+  std::string kernel, scalar, config;
+  std::uint64_t samples = 0;
+  double level = 0, target = 0.9;  // the per-test significance level and the probability of rejection
+  std::vector<PowerFigure> figures;
+};
+
 struct BatteryRun {
   double alpha = 0.01;  // family-wise significance level of the run
   Correction correction = Correction::kHolm;
@@ -61,6 +82,7 @@ struct BatteryRun {
   std::optional<bool> complete;                // false while the CLI is still running (or was killed)
   std::optional<ShardOf> shard;                // set when the run is one shard of a larger run
   std::vector<TestResult> results;
+  std::vector<CasePower> power;  // one per case with a chi2 map; power.h's run_power fills it
 
   // The number of results with a p-value: the m of the correction.
   std::size_t statistical_tests() const;
