@@ -150,7 +150,7 @@ namespace {
 
 struct ValidateArgs {
   Selection sel;
-  BatteryOptions opt;
+  BatteryOptions opt{.threads = 0};  // every core unless --threads
   double alpha = 0.01;
   Correction corr = Correction::kHolm;
   std::string json;
