@@ -4,7 +4,7 @@
 #   cmake -DMODE=install|add_subdirectory -DSOURCE=<warpcheck source> -DBUILD=<warpcheck build> -DWORK=<scratch>
 #         -DGENERATOR=... -DCXX=... -DLAUNCHER=... -DBUILD_TYPE=... -DWERROR=ON|OFF -P consumer_test.cmake
 # install: `cmake --install BUILD --prefix WORK/prefix`, then the consumer finds it by CMAKE_PREFIX_PATH alone.
-# add_subdirectory: the consumer adds SOURCE as a subdirectory (WARPCHECK_SOURCE_DIR), building the library itself.
+# add_subdirectory: the consumer adds SOURCE as a subdirectory (WARPCHECK_CLONE), building the library itself.
 # Either way the consumer may not find PNG, OpenEXR or Google Benchmark (the tests', the report's and the
 # benchmarks' needs, not the libraries'), and its own CMakeLists.txt sets no C++ standard: the targets carry C++20.
 # WORK is kept between runs (only its CMakeCache.txt is removed), so that a rerun rebuilds only what changed.
@@ -32,7 +32,7 @@ if(MODE STREQUAL "install")
   run(${CMAKE_COMMAND} --install ${BUILD} --prefix ${WORK}/prefix)
   list(APPEND args -DCMAKE_PREFIX_PATH=${WORK}/prefix)
 elseif(MODE STREQUAL "add_subdirectory")
-  list(APPEND args -DWARPCHECK_SOURCE_DIR=${SOURCE} -DWARPCHECK_WARNINGS_AS_ERRORS=${WERROR})
+  list(APPEND args -DWARPCHECK_CLONE=${SOURCE} -DWARPCHECK_WARNINGS_AS_ERRORS=${WERROR})
 else()
   message(FATAL_ERROR "consumer_test.cmake: MODE is install or add_subdirectory")
 endif()
