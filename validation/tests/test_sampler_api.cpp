@@ -6,6 +6,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "warpcheck/validation/battery.h"
 
@@ -55,7 +56,9 @@ TEST(SamplerApi, WeightOffByOneThousandthOnATenthOfTheSupportIsRejected) {
   EXPECT_FALSE(find(r, "weight").passed) << format_table(r);
   EXPECT_NEAR(find(r, "weight").statistic, 1e-3, 1e-9);
   for (const auto& x : r) {
-    if (x.test != "weight") EXPECT_TRUE(x.passed) << x.test;  // the direction, pdf and warp are right
+    if (x.test != "weight") {
+      EXPECT_TRUE(x.passed) << x.test;  // the direction, pdf and warp are right
+    }
   }
 }
 
@@ -120,10 +123,13 @@ TEST(SamplerApi, SupportSlackIs64EpsilonsOfTheScalarType) {
 TEST(SamplerApi, BatteryRunsOnOneThreadUnlessAsked) { EXPECT_EQ(BatteryOptions{}.threads, 1); }
 
 TEST(FormatTable, ColumnsStayAlignedWhenANameIsLong) {
-  TestResult a, b;
-  a.kernel = "k", a.scalar = "double", a.config = "short", a.test = "chi2";
-  b.kernel = "k", b.scalar = "double", b.config = std::string(60, 'c'), b.test = "chi2";
-  const std::string t = format_table({a, b});
+  const auto row = [](std::string config) {
+    TestResult r;
+    r.kernel = std::string("k"), r.scalar = std::string("double"), r.config = std::move(config);
+    r.test = std::string("chi2");
+    return r;
+  };
+  const std::string t = format_table({row("short"), row(std::string(60, 'c'))});
   // Every line has its test column ("test" or "chi2") at the same offset.
   std::size_t offset = std::string::npos;
   for (std::size_t begin = 0, end; (end = t.find('\n', begin)) != std::string::npos; begin = end + 1) {
