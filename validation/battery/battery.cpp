@@ -29,7 +29,11 @@ BatteryOptions checked_options(const SamplerUnderTest& s, const BatteryOptions& 
   // has a relative standard deviation of 7e-3). Double and long double keep quadrature_tolerance.
   BatteryOptions o = options;
   o.quadrature_tolerance = std::max(o.quadrature_tolerance, 16 * double(scalar_epsilon(s.scalar)));
-  if (!s.sample || !s.pdf) throw std::invalid_argument("SamplerUnderTest needs sample and pdf");
+  if (!s.sample || !s.pdf) {
+    if (!s.sample_u || !s.pdf) throw std::invalid_argument("SamplerUnderTest needs sample (or sample_u) and pdf");
+  }
+  if (s.uniforms < 2 || (s.uniforms > 2 && !s.sample_u))
+    throw std::invalid_argument("SamplerUnderTest: uniforms >= 2, and sample_u for more than 2");
   if (!(s.bounding_cap.one_minus_cos > 0 && s.bounding_cap.one_minus_cos <= 2) || !all_finite(s.bounding_cap.axis))
     throw std::invalid_argument("SamplerUnderTest needs a bounding cap with 0 < 1 - cos(half-angle) <= 2");
   if (o.samples < 1000 || o.radial_bins < 1 || o.azimuth_bins < 1 || o.ks_cdf_nodes < 16)
@@ -52,6 +56,7 @@ Prepared prepare(const SamplerUnderTest& s, const BatteryOptions& o) {
   p.independent = beside(o, [&s, o] {
     std::vector<TestResult> r{pdf_consistency(s, o)};
     for (TestResult& n : normalizations(s)) r.push_back(std::move(n));
+    if (s.eval) r.push_back(weight_check(s, o));
     return r;
   });
   if (o.progress) o.progress("quadrature", 0);
@@ -103,18 +108,24 @@ std::vector<std::vector<TestResult>> run_battery_seeds(const SamplerUnderTest& s
 }
 
 std::string format_table(const std::vector<TestResult>& results) {
+  // Each text column at least its usual width (so that the warpcheck command's tables, one per case, line up), wider
+  // when an entry is longer.
+  std::size_t w[4] = {38, 11, 24, 30};
+  for (const auto& r : results)
+    w[0] = std::max(w[0], r.kernel.size()), w[1] = std::max(w[1], r.scalar.size()),
+    w[2] = std::max(w[2], r.config.size()), w[3] = std::max(w[3], r.test.size());
   std::ostringstream o;
-  char line[512];
-  std::snprintf(line, sizeof line, "%-38s %-11s %-24s %-30s %12s %10s  %s\n", "kernel", "scalar", "config", "test",
-                "statistic", "p-value", "verdict");
-  o << line;
-  for (const auto& r : results) {
-    std::snprintf(line, sizeof line, "%-38s %-11s %-24s %-30s %12s %10s  %s\n", r.kernel.c_str(), r.scalar.c_str(),
-                  r.config.c_str(), r.test.c_str(), format_g(r.statistic, 4).c_str(),
-                  r.p_value ? format_g(*r.p_value, 3).c_str() : "-",
-                  r.passed ? "pass" : (r.known_limitation.empty() ? "FAIL" : "fail (known limitation)"));
-    o << line;
-  }
+  auto row = [&](const std::string& kernel, const std::string& scalar, const std::string& config,
+                 const std::string& test, const std::string& statistic, const std::string& p, const char* verdict) {
+    char line[64];
+    std::snprintf(line, sizeof line, " %12s %10s  %s\n", statistic.c_str(), p.c_str(), verdict);
+    o << kernel << std::string(w[0] - kernel.size() + 1, ' ') << scalar << std::string(w[1] - scalar.size() + 1, ' ')
+      << config << std::string(w[2] - config.size() + 1, ' ') << test << std::string(w[3] - test.size(), ' ') << line;
+  };
+  row("kernel", "scalar", "config", "test", "statistic", "p-value", "verdict");
+  for (const auto& r : results)
+    row(r.kernel, r.scalar, r.config, r.test, format_g(r.statistic, 4), r.p_value ? format_g(*r.p_value, 3) : "-",
+        r.passed ? "pass" : (r.known_limitation.empty() ? "FAIL" : "fail (known limitation)"));
   return o.str();
 }
 

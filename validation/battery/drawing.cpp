@@ -40,6 +40,12 @@ Real scalar_epsilon(const std::string& scalar) {
   return DBL_EPSILON;
 }
 
+Sample draw_one(const SamplerUnderTest& s, std::mt19937_64& g, std::vector<double>& u) {
+  u.resize(std::size_t(s.uniforms));
+  for (double& x : u) x = uniform01(g);
+  return sample_at(s, u);
+}
+
 int thread_count(const BatteryOptions& o) {
   if (o.threads > 0) return o.threads;
   return std::max(1u, std::thread::hardware_concurrency());
@@ -77,7 +83,11 @@ void check_block_forms(const SamplerUnderTest& s) {
         block_form_disagrees(s, "sample_block", "sample",
                              "u = (" + std::to_string(u0[i]) + ", " + std::to_string(u1[i]) + ")");
   } else {
-    for (std::size_t i = 0; i < u0.size(); ++i) block[i] = s.sample(u0[i], u1[i]);
+    for (std::size_t i = 0; i < u0.size(); ++i) {
+      std::vector<double> u(std::size_t(s.uniforms), 0.5);
+      u[0] = u0[i], u[1] = u1[i];
+      block[i] = sample_at(s, u);
+    }
   }
   if (!s.pdf_block) return;
   // The samples' directions (where the pdf is nonzero, however thin the support) and points of the bounding cap.
@@ -260,10 +270,15 @@ Draws draw(const SamplerUnderTest& s, const BatteryOptions& o, const std::vector
     std::array<double, kBlock> u0, u1;
     std::array<Sample, kBlock> block;
     const std::size_t end = std::min<std::size_t>(o.samples, (c + 1) * kChunk);
+    std::vector<double> u(std::size_t(s.uniforms));
     for (std::size_t b = c * kChunk; b < end; b += kBlock) {
       const std::size_t n = std::min(kBlock, end - b);
-      for (std::size_t j = 0; j < n; ++j) u0[j] = uniform01(g), u1[j] = uniform01(g);
-      sample_many(s, {u0.data(), n}, {u1.data(), n}, {block.data(), n});
+      if (s.sample_u) {
+        for (std::size_t j = 0; j < n; ++j) block[j] = draw_one(s, g, u);
+      } else {
+        for (std::size_t j = 0; j < n; ++j) u0[j] = uniform01(g), u1[j] = uniform01(g);
+        sample_many(s, {u0.data(), n}, {u1.data(), n}, {block.data(), n});
+      }
       tally.add(binner, {block.data(), n});
     }
     std::lock_guard lock(m);
@@ -271,6 +286,38 @@ Draws draw(const SamplerUnderTest& s, const BatteryOptions& o, const std::vector
     if (o.progress && (++done % 16 == 0 || done == chunks)) o.progress("sampling", double(done) / chunks);
   });
   return d;
+}
+
+TestResult weight_check(const SamplerUnderTest& s, const BatteryOptions& o) {
+  TestResult r;
+  r.kernel = s.kernel, r.scalar = s.scalar, r.config = s.config, r.test = "weight";
+  std::mt19937_64 g = stream(o.seed, s, 4, 0);
+  std::vector<double> u;
+  const std::size_t n = std::min<std::uint64_t>(o.samples, kWeightSamples);
+  std::size_t checked = 0, missing = 0, wrong = 0;
+  Real worst = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const Sample x = draw_one(s, g, u);
+    if (!x.valid || !(x.pdf > 0) || !std::isfinite(x.pdf)) continue;
+    if (!x.weight) {
+      ++missing;
+      continue;
+    }
+    // Relative error against f / pdf; where f is zero the weight must be zero too (an infinite error otherwise).
+    const Real expected = s.eval(x.direction) / x.pdf;
+    const Real e = expected != 0 ? std::abs(*x.weight / expected - 1)
+                                 : (*x.weight == 0 ? Real(0) : std::numeric_limits<Real>::infinity());
+    if (!(e <= s.tolerance)) ++wrong;
+    if (!(e <= worst)) worst = std::isnan(e) ? std::numeric_limits<Real>::infinity() : e;
+    ++checked;
+  }
+  r.statistic = double(worst);
+  r.passed = checked > 0 && missing == 0 && wrong == 0;
+  std::ostringstream detail;
+  detail << "max |weight / (eval / pdf) - 1| " << double(worst) << " over " << checked << " samples with pdf > 0 ("
+         << wrong << " beyond the tolerance " << double(s.tolerance) << ", " << missing << " without a weight)";
+  r.detail = detail.str();
+  return r;
 }
 
 }  // namespace warpcheck::validation::battery

@@ -166,9 +166,16 @@ int list_main(const std::vector<std::string>& a) {
 
 namespace {
 
+// The command's battery options: every core unless --threads (the library's default is one thread).
+BatteryOptions every_core() {
+  BatteryOptions o;
+  o.threads = 0;
+  return o;
+}
+
 struct ValidateArgs {
   Selection sel;
-  BatteryOptions opt;
+  BatteryOptions opt = every_core();
   double alpha = 0.01;
   Correction corr = Correction::kHolm;
   std::string json;

@@ -1,59 +1,49 @@
-// The README's "Validate your own sampler" example, compiled and run exactly as printed there (the code between
-// the markers is copied into README.md; ReadmeExample.IsTheCodeInTheReadme checks they are the same text).
-// README-EXAMPLE-BEGIN
+// The README's "Validate your own sampler" prints a consumer project: examples/consumer/CMakeLists.txt and
+// examples/consumer/my_sampler_test.cpp, which the tests consumer.install and consumer.add_subdirectory configure,
+// build and run from outside this tree. These tests check that the README prints exactly those files, and links
+// every other example.
 #include <gtest/gtest.h>
-#include <cmath>
-#include <numbers>
-#include "warpcheck/validation/battery.h"
-using namespace warpcheck::validation;
 
-// A renderer's own sampler: uniform directions in a cone of half-angle 0.3 rad around +z.
-struct MyConeSampler {
-  double cos_max = std::cos(0.3), density = 1 / (2 * std::numbers::pi * (1 - cos_max));
-  Sample sample(double u0, double u1) const {
-    const double c = 1 - u0 * (1 - cos_max), s = std::sqrt(1 - c * c), phi = 2 * std::numbers::pi * u1;
-    return {Vec3L(s * std::cos(phi), s * std::sin(phi), c), density, true};
-  }
-  double pdf(const Vec3L& w) const { return w.z() >= cos_max ? density : 0; }
-};
-
-TEST(MyConeSampler, PassesTheWarpcheckBattery) {
-  MyConeSampler my;
-  SamplerUnderTest s;
-  s.kernel = "my-cone", s.config = "0.3 rad";
-  s.sample = [&](double u0, double u1) { return my.sample(u0, u1); };
-  s.pdf = [&](const Vec3L& w) { return Real(my.pdf(w)); };
-  s.bounding_cap = {Vec3L(0, 0, 1), Real(1 - my.cos_max)};  // contains every sample: the chi2 grid's cap
-  BatteryOptions options;
-  options.samples = 1'000'000;
-  const auto results = validate(s, options);  // chi2, 2 KS, pdf integral, pdf/Jacobian; alpha 0.01, Holm
-  EXPECT_TRUE(all_passed(results)) << format_table(results);
-}
-// README-EXAMPLE-END
-
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
 
 namespace {
-std::string slurp(const std::string& path) {
+
+std::string slurp(const std::filesystem::path& path) {
   std::ifstream in(path);
   std::ostringstream s;
   s << in.rdbuf();
   return s.str();
 }
+
+const std::filesystem::path kSource = WARPCHECK_SOURCE_DIR;
+
 }  // namespace
 
-TEST(ReadmeExample, IsTheCodeInTheReadme) {
-  const std::string self = slurp(WARPCHECK_SOURCE_DIR "/validation/tests/test_readme_example.cpp");
-  const std::string readme = slurp(WARPCHECK_SOURCE_DIR "/README.md");
-  const std::string begin = "// README-EXAMPLE-BEGIN\n", end = "// README-EXAMPLE-END";
-  const auto b = self.find(begin) + begin.size(), e = self.find(end);
-  ASSERT_NE(self.find(begin), std::string::npos);
-  const std::string example = self.substr(b, e - b);
-  EXPECT_NE(readme.find("```cpp\n" + example + "```"), std::string::npos)
-      << "README.md must contain, in a ```cpp block, exactly the example between the markers of this file";
+TEST(ReadmeExample, PrintsTheConsumerProjectsTestVerbatim) {
+  const std::string example = slurp(kSource / "examples/consumer/my_sampler_test.cpp");
+  ASSERT_FALSE(example.empty());
+  EXPECT_NE(slurp(kSource / "README.md").find("```cpp\n" + example + "```"), std::string::npos)
+      << "README.md must contain, in a ```cpp block, exactly examples/consumer/my_sampler_test.cpp";
   int lines = 0;
   for (char c : example) lines += c == '\n';
-  EXPECT_LE(lines, 30) << "the issue asks for at most 30 lines";
+  EXPECT_LE(lines, 30) << "the README's first example stays at most 30 lines";
+}
+
+TEST(ReadmeExample, PrintsTheConsumerProjectsCMakeListsVerbatim) {
+  const std::string cmake = slurp(kSource / "examples/consumer/CMakeLists.txt");
+  ASSERT_FALSE(cmake.empty());
+  EXPECT_NE(slurp(kSource / "README.md").find("```cmake\n" + cmake + "```"), std::string::npos)
+      << "README.md must contain, in a ```cmake block, exactly examples/consumer/CMakeLists.txt";
+}
+
+TEST(ReadmeExample, LinksEveryOtherExample) {
+  const std::string readme = slurp(kSource / "README.md");
+  for (const auto& e : std::filesystem::directory_iterator(kSource / "examples")) {
+    if (e.path().extension() != ".cpp") continue;
+    EXPECT_NE(readme.find("(examples/" + e.path().filename().string() + ")"), std::string::npos)
+        << "README.md must link examples/" << e.path().filename().string();
+  }
 }

@@ -32,7 +32,8 @@
 namespace warpcheck::validation {
 
 struct BatteryOptions {
-  std::uint64_t samples = 10'000'000;  // per sampler; see README "Choosing the sample count"
+  // Per sampler: README.md, "Validate your own sampler", "Choosing the sample count".
+  std::uint64_t samples = 10'000'000;
   std::uint64_t seed = 1;
   int radial_bins = 16, azimuth_bins = 32;  // chi-square grid: 512 equal-area bins over the bounding cap
   double min_expected = 5;                  // bins expected to hold fewer samples are pooled
@@ -40,7 +41,10 @@ struct BatteryOptions {
   double quadrature_tolerance = 1e-8;       // relative tolerance of every 1D rule of the quadrature
   bool reference_quadrature = false;        // nested adaptive quadrature of every bin and KS slab (slow)
   int consistency_points = 2048;            // primary-sample points of the pdf/Jacobian check
-  int threads = 0;                          // 0: hardware concurrency
+  // Worker threads: 1 by default, so that a user's test under `ctest -j N` takes one core, as ctest assumes; 0 uses
+  // every core (std::thread::hardware_concurrency; the warpcheck command's default). The results are the same,
+  // bit for bit, whatever the count.
+  int threads = 1;
   // Called with (phase, fraction done) during long work; may be empty.
   std::function<void(const std::string&, double)> progress;
 };
@@ -61,10 +65,11 @@ std::size_t apply_correction(std::vector<TestResult>& results, double alpha, Cor
 
 // True when every result passed or is a documented known limitation.
 bool all_passed(const std::vector<TestResult>& results);
-// A fixed-width table: kernel, scalar, config, test, statistic, p-value, verdict.
+// A table: kernel, scalar, config, test, statistic, p-value, verdict; each column as wide as its longest entry.
 std::string format_table(const std::vector<TestResult>& results);
 
-// Convenience for a user's own GoogleTest: run the battery on one sampler and judge it at alpha.
+// Convenience for a user's own GoogleTest: run the battery on one sampler and judge it at alpha (on options.threads
+// threads: one unless set).
 std::vector<TestResult> validate(const SamplerUnderTest& s, const BatteryOptions& options = {}, double alpha = 0.01,
                                  Correction c = Correction::kHolm);
 

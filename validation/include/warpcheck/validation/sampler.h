@@ -4,8 +4,10 @@
 // ways to get one:
 //
 //  1. Your own sampler (any precision, any geometry type): fill in the fields by hand with lambdas.
-//     `sample` and `pdf` are required, and so is `bounding_cap`, a spherical cap that contains every
-//     direction the sampler can return (the chi-square grid is laid over it, so make it tight).
+//     `sample` (or `sample_u`, for a sampler of more than two uniform numbers) and `pdf` are required, and so is
+//     `bounding_cap`, a spherical cap that contains every direction the sampler can return: the chi-square grid
+//     and the KS coordinates are laid over it, so make it tight; a sampler without a tight cap (a BSDF) takes
+//     hemisphere(n) or whole_sphere(). README.md, "Validate your own sampler", says which field matters when.
 //
 //  2. A kernel trait satisfying the `Kernel` concept below, as lib/warpcheck/catalogue.h's kernels do (name,
 //     Scalar, Geometry, View, static view / sample / pdf / bounding_cap): `bind_kernel<K>(config, geometry)`
@@ -21,6 +23,7 @@
 #include <cmath>
 #include <concepts>
 #include <functional>
+#include <limits>
 #include <optional>
 #include <span>
 #include <string>
@@ -30,6 +33,13 @@
 
 namespace warpcheck::validation {
 
+// The kernels' geometry types and constants, by their names in this namespace too.
+using warpcheck::Cap;
+using warpcheck::Frame;
+using warpcheck::kPi;
+using warpcheck::kTwoPi;
+using warpcheck::Vec3;
+
 using Real = long double;
 using Vec3L = Vec3<long double>;
 
@@ -37,7 +47,15 @@ struct Sample {
   Vec3L direction = Vec3L::Zero();
   Real pdf = 0;
   bool valid = false;
+  // Optional: the sampler's weight, the estimate f(direction) / pdf it returns to the renderer (a BSDF sampler's
+  // f cos / pdf). With SamplerUnderTest::eval the battery checks it (the test "weight").
+  std::optional<Real> weight = std::nullopt;
 };
+
+// Bounding caps for samplers without a tight one: the hemisphere around the unit normal n, and the whole sphere
+// (1 - cos of the half-angle = 1 and 2). The chi-square grid keeps its equal-area rings and columns on them.
+inline Cap<Real> hemisphere(const Vec3L& n) { return Cap<Real>{n.normalized(), 1}; }
+inline Cap<Real> whole_sphere() { return Cap<Real>{Vec3L(0, 0, 1), 2}; }
 
 // An independently computed measure that the sampler's normalisation must equal (e.g. the cap's solid angle
 // for a uniform cone sampler, the projected solid angle for a projected-solid-angle sampler).
@@ -52,9 +70,19 @@ struct SamplerUnderTest {
   std::string scalar;  // "float", "double", "long double" or whatever the sampler computes in
   std::string config;  // configuration name, e.g. "near"
 
-  std::function<Sample(double u0, double u1)> sample;  // required
+  std::function<Sample(double u0, double u1)> sample;  // required (or sample_u)
   std::function<Real(const Vec3L&)> pdf;               // required: density of a unit direction
   Cap<Real> bounding_cap;                              // required: contains the support
+
+  // A sampler of more than two uniform numbers (a lobe, a triangle or a light chosen by the third): `uniforms`
+  // numbers per sample, passed in u (u.size() == uniforms), instead of `sample`. The chi-square grid and the KS
+  // tests are on the direction as always; pdf-consistency compares the returned pdf with pdf(direction) only (the
+  // warp's area element is that of one branch, not the mixture's density).
+  int uniforms = 2;
+  std::function<Sample(std::span<const double> u)> sample_u;
+  // Optional: the integrand f of the sampler's weight (a BSDF times the cosine). Every drawn sample with pdf > 0
+  // must then carry weight == eval(direction) / pdf to `tolerance` (the test "weight").
+  std::function<Real(const Vec3L&)> eval;
 
   // Optional: membership in the support, used to flag samples outside the light. Default: pdf(w) > 0.
   std::function<bool(const Vec3L&)> in_support;
@@ -87,6 +115,11 @@ struct SamplerUnderTest {
   // the battery then checks only that every sample is declined and the pdf is zero everywhere.
   bool expect_no_sample = false;
 };
+
+// One sample from the primary sample u (u.size() == s.uniforms), through sample_u or sample.
+inline Sample sample_at(const SamplerUnderTest& s, std::span<const double> u) {
+  return s.sample_u ? s.sample_u(u) : s.sample(u[0], u[1]);
+}
 
 // The sampler's samples (pdfs) of a block of primary samples (directions), through the block form when it has one.
 inline void sample_many(const SamplerUnderTest& s, std::span<const double> u0, std::span<const double> u1,
@@ -133,6 +166,12 @@ template <class T> constexpr const char* scalar_name() {
   else
     return "custom";
 }
+
+// How far, in radians, rounding in scalar type T may put a sampler's direction beyond its support's edge: 64
+// machine epsilons of T (3.8e-6 rad for float, 1.4e-14 for double). The battery counts samples that far beyond the
+// bounding cap as inside it; a sampler's pdf is called at its own samples' directions (pdf-consistency, weight) and
+// must return the density there too, so a float sampler's pdf accepts directions that far outside the light.
+template <class T> constexpr Real support_slack() { return 64 * Real(std::numeric_limits<T>::epsilon()); }
 
 // A uniform number in [0, 1) as T: rounding to float can turn 1 - 2^-53 into 1, which some warps map onto a
 // measure-zero set of infinite density (a silhouette); keep it below 1.
