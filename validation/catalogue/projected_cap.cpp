@@ -202,6 +202,10 @@ template <template <class> class K, class T> Case make_case(const ProjectedCapCo
   k.scalar = scalar_name<T>();
   k.config = c.name;
   k.description = c.description;
+  if (std::is_same_v<T, float> && M == CutDiskInverse::kExact && std::string(c.name) == "tiny")
+    k.known_limitation =
+        "float exact inverse on a 2e-3 rad light: chi2-rings sees a coherent radial error (p = 1.8e-6 at 1e6 samples, "
+        "seed 1) that the float default kernel on the same light does not show (p = 0.12); cause not yet analysed";
   k.make = [c] {
     SamplerUnderTest s = bind_kernel<K<T>, K<Real>>(c.name, cast<T>(c.g), c.g);
     const ProjectedCapView<Real> pr = K<Real>::view(c.g);
