@@ -441,7 +441,8 @@ int merge_battery(const std::vector<std::string>& files, const std::vector<std::
     } catch (const std::runtime_error& e) {
       throw std::runtime_error(files[i] + ": " + e.what());
     }
-  const BatteryRun run = merge_shards(shards);
+  BatteryRun run = merge_shards(shards);
+  run.power = run_power(run);  // at the union's corrected level, as the unsharded run computes them
   std::size_t failed = 0;
   for (const TestResult& r : run.results) failed += r.failed();
   const std::string text = to_json(run);
