@@ -1,7 +1,9 @@
 # Install rules and the package configuration (included from the top-level CMakeLists.txt with WARPCHECK_INSTALL):
 #   include/warpcheck/*.h               the kernels (lib/warpcheck/)
 #   include/warpcheck/validation/*.h    the validation API (validation/include/warpcheck/validation/)
-#   lib/libwarpcheck_validation.a       the battery, the registry, the searches
+#   lib/libwarpcheck_validation.a       the battery (warpcheck::validation)
+#   lib/libwarpcheck_catalogue.a        warpcheck's own kernels' registry, negative controls and searches
+#                                       (warpcheck::catalogue)
 #   lib/cmake/warpcheck/                warpcheckConfig.cmake, its version file and the exported targets
 # The battery's, the catalogue's and the searches' own headers (validation/battery/*.h, ...) are not installed:
 # the public headers never include them.
@@ -10,7 +12,7 @@ include(CMakePackageConfigHelpers)
 set(WARPCHECK_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/warpcheck)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/lib/warpcheck ${PROJECT_SOURCE_DIR}/validation/include/warpcheck
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR} COMPONENT devel FILES_MATCHING PATTERN "*.h")
-install(TARGETS warpcheck_kernels warpcheck_validation EXPORT warpcheckTargets
+install(TARGETS warpcheck_kernels warpcheck_validation warpcheck_catalogue EXPORT warpcheckTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT devel)
 install(EXPORT warpcheckTargets NAMESPACE warpcheck:: DESTINATION ${WARPCHECK_CMAKE_DIR} COMPONENT devel)
 
