@@ -12,7 +12,11 @@ include(CMakePackageConfigHelpers)
 set(WARPCHECK_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/warpcheck)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/lib/warpcheck ${PROJECT_SOURCE_DIR}/validation/include/warpcheck
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR} COMPONENT devel FILES_MATCHING PATTERN "*.h")
-install(TARGETS warpcheck_kernels warpcheck_validation warpcheck_catalogue EXPORT warpcheckTargets
+set(WARPCHECK_INSTALLED_TARGETS warpcheck_kernels warpcheck_validation)
+if(WARPCHECK_BUILD_CATALOGUE)
+  list(APPEND WARPCHECK_INSTALLED_TARGETS warpcheck_catalogue)
+endif()
+install(TARGETS ${WARPCHECK_INSTALLED_TARGETS} EXPORT warpcheckTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT devel)
 install(EXPORT warpcheckTargets NAMESPACE warpcheck:: DESTINATION ${WARPCHECK_CMAKE_DIR} COMPONENT devel)
 
