@@ -6,7 +6,8 @@
 #   OUT                  where the binaries go; beside each, <target>_seed_corpus.zip (data/fuzz/<target>/corpus)
 #                        and <target>.dict (data/fuzz/<target>/dict)
 #   SRC                  not read: the source tree is the one this script is in
-# Optional: WARPCHECK_FUZZ_JOBS compiles at once (default: nproc), EIGEN_INCLUDE (default /usr/include/eigen3).
+# Optional: WARPCHECK_FUZZ_JOBS compiles at once (default: nproc), EIGEN_INCLUDE (default /usr/include/eigen3),
+# WARPCHECK_FUZZ_KERNELS the kernels to build (space-separated names of fuzz/targets/*.h; default: all).
 # Needs Eigen 3.4 and Boost headers, zip. The targets are header-only: each is fuzz/oss-fuzz/target.cpp compiled
 # with the kernel, trait and scalar as macros; the trait's name is the kernel's in CamelCase (as fuzz/CMakeLists.txt
 # derives it), and a static_assert in the source rejects a wrong one. Stored findings (regressions/) are not
@@ -41,7 +42,10 @@ build_target() {
 export -f build_target
 export root eigen CXX CXXFLAGS LIB_FUZZING_ENGINE OUT
 
-for header in "$root"/fuzz/targets/*.h; do
-  kernel=$(basename "$header" .h)
+kernels=${WARPCHECK_FUZZ_KERNELS:-$(basename -s .h "$root"/fuzz/targets/*.h)}
+for kernel in $kernels; do
+  [ -f "$root/fuzz/targets/$kernel.h" ] || { echo "build.sh: no fuzz target fuzz/targets/$kernel.h" >&2; exit 2; }
+done
+for kernel in $kernels; do
   printf '%s float\n%s double\n' "$kernel" "$kernel"
 done | xargs -P "$jobs" -L 1 bash -euc 'build_target "$0" "$1"'

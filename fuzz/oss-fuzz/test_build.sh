@@ -6,6 +6,7 @@
 # loaded, without a crash or sanitizer report.
 # CC/CXX are "ccache clang"/"ccache clang++" when ccache is installed (the test builds 28 targets; a cold build
 # takes minutes): WARPCHECK_OSSFUZZ_CCACHE=0 builds without it. WARPCHECK_FUZZ_JOBS as in build.sh (default 2).
+# Arguments: kernels (names of fuzz/targets/*.h) to build and check instead of all of them.
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
@@ -16,6 +17,8 @@ flags+=" -fsanitize=address -fsanitize-address-use-after-scope -fsanitize=fuzzer
 export CC="${launcher}clang" CXX="${launcher}clang++" CFLAGS="$flags" CXXFLAGS="$flags"
 export LIB_FUZZING_ENGINE=-fsanitize=fuzzer OUT=$tmp/out SRC=$tmp/src WORK=$tmp/work
 export WARPCHECK_FUZZ_JOBS=${WARPCHECK_FUZZ_JOBS:-2}
+kernels=${*:-$(basename -s .h "$root"/fuzz/targets/*.h)}
+export WARPCHECK_FUZZ_KERNELS=$kernels
 mkdir -p "$SRC" "$WORK"
 start=$(date +%s)
 "$root/fuzz/oss-fuzz/build.sh" >"$tmp/build.log" 2>&1 || { cat "$tmp/build.log"; exit 1; }
@@ -23,8 +26,7 @@ echo "build.sh: $(($(date +%s) - start)) s"
 
 fail=0
 count=0
-for header in "$root"/fuzz/targets/*.h; do
-  kernel=$(basename "$header" .h)
+for kernel in $kernels; do
   for scalar in float double; do
     target=fuzz_${kernel}_${scalar}
     count=$((count + 1))
