@@ -146,7 +146,7 @@ std::vector<PolygonConfig> configs() {
 // Arvo's noise is ~eps / Omega of the light's width in the long double warp, which pdf-consistency differentiates
 // at h <= 1e-4: measured 1.4e-6 at 5.3e-8 sr (1 cm at 40 m), 2.9e-6 at a random light of 1.4e-8 sr. Below 1e-6 sr
 // the largest of 2048 points may exceed the tolerance; above, eps / Omega < 1.1e-13 keeps it under ~1e-7 (the 1 cm
-// light's 1.4e-6 scaled by eps / Omega). The named configurations' other lights subtend more than 1e-2 sr.
+// light's 1.4e-6 scaled by eps / Omega). The named configurations' other lights subtend ~1e-3 sr or more.
 constexpr long double kArvoCancellingSolidAngle = 1e-6L;
 
 // The relative error of the warp's density along xi_0 that stopping after Peters 2021's two tangent-line
