@@ -71,6 +71,19 @@ template <class T> PolygonLightGeometry<T> ltc_transformed_polygon(const Polygon
   return tg;
 }
 
+// M^-1 P scaled exactly (by a power of two) so that its largest coordinate lies in [1, 2). Eq. 10 integrates over
+// M^-1 P as a cone of directions seen from the origin, which no positive scale changes (p_M is invariant under
+// M -> s M too), but its coordinates scale by 1 / s: unscaled, an M of scale 3e82 puts them at 1e-82, where
+// check_polygon's squared area (a product of four coordinates) underflows and the light is refused as zero-sized.
+template <class T> PolygonLightGeometry<T> ltc_unit_magnitude(PolygonLightGeometry<T> tg) {
+  T magnitude = 0;
+  for (int i = 0; i < tg.light.count; ++i) magnitude = std::max(magnitude, tg.light.vertices[i].cwiseAbs().maxCoeff());
+  if (!(magnitude > T(0)) || !std::isfinite(magnitude)) return tg;
+  const int e = std::ilogb(magnitude);
+  for (int i = 0; i < tg.light.count; ++i) tg.light.vertices[i] = ldexp(tg.light.vertices[i], -e);
+  return tg;
+}
+
 // The rounding of M^-1 P's vertices relative to |M^-1 v|_inf (check_polygon's vertex_rounding): the frame change's
 // and the product's, 3 eps |M^-1|_F |v|_2 <= 3 sqrt(3) eps cond_F(M) |M^-1 v|_inf.
 template <class T> T ltc_vertex_rounding(const Mat3<T>& m, const Mat3<T>& m_inv) {
@@ -89,7 +102,8 @@ template <class T> LtcPolygonView<T> make_ltc_polygon_view(const LtcPolygonGeome
   // |M| > 0 (Sec. 4.1). A singular or reflecting M has no LTC; an M whose inverse overflows neither.
   if (!ltc_inverse(g.m, &v.m_inv, &v.det)) return v.reason = NoSample::kInvalidGeometry, v;
   v.det_inv = T(1) / v.det;
-  v.transformed = make_polygon_projected_view(ltc_transformed_polygon(pv, v.m_inv), ltc_vertex_rounding(g.m, v.m_inv));
+  v.transformed = make_polygon_projected_view(ltc_unit_magnitude(ltc_transformed_polygon(pv, v.m_inv)),
+                                              ltc_vertex_rounding(g.m, v.m_inv));
   if (!v.transformed.valid()) return v.reason = v.transformed.reason, v;
   v.integral = v.transformed.projected_solid_angle / kPi<T>;
   return v;

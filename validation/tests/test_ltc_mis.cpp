@@ -79,6 +79,34 @@ TEST(Ltc, SingularOrReflectingTransformsGiveNoSample) {
             NoSample::kInvalidGeometry);
 }
 
+// The LTC of s M is that of M for every s > 0: scaled by a power of two, M gives the same samples and pdfs bit for
+// bit as long as |M| stays a normal number. At 2^275 (the fitted form at 6e82) M^-1 P lies at 1e-82, where Newell's
+// vector's squared norm underflows (the view refused it as zero-sized); at 2^-300 its coordinates' fourth powers
+// overflow.
+TEST(Ltc, AnMatrixScaledByAPowerOfTwoSamplesAsTheUnscaledOneWhileItsDeterminantIsNormal) {
+  const auto pg = test_polygon().cast<double>();
+  Mat3<double> m;
+  m << 2, 0, 4, 0, 1, 0, 0.25, 0, 1;
+  const LtcPolygonView<double> v = make_ltc_polygon_view(LtcPolygonGeometry<double>{pg, m});
+  ASSERT_TRUE(v.valid());
+  std::mt19937_64 r(5);
+  std::uniform_real_distribution<double> u(0, 1);
+  for (const int e : {-300, -200, -100, 100, 200, 275, 300}) {  // |s M| = 2^(3 e) |M|, |M| = 1
+    const LtcPolygonView<double> s =
+        make_ltc_polygon_view(LtcPolygonGeometry<double>{pg, Mat3<double>(m * std::ldexp(1.0, e))});
+    ASSERT_TRUE(s.valid()) << "2^" << e << ": " << to_string(s.reason);
+    EXPECT_EQ(s.integral, v.integral) << e;
+    for (int i = 0; i < 100; ++i) {
+      const Vec2<double> x(u(r), u(r));
+      const DirectionSample<double> a = sample_ltc_polygon(v, x), b = sample_ltc_polygon(s, x);
+      ASSERT_TRUE(a.valid() && b.valid()) << e;
+      EXPECT_EQ(a.direction, b.direction) << e;
+      EXPECT_EQ(a.pdf, b.pdf) << e;
+      EXPECT_EQ(pdf_ltc_polygon(v, a.direction), pdf_ltc_polygon(s, a.direction)) << e;
+    }
+  }
+}
+
 // pdf() at the sampler's own direction gives the sampler's pdf, to the rounding of the density formula (16 eps, the
 // fuzz target's allowance), for a near-singular M (sigma_1 / sigma_3 = 1024): Eigen's inverse is off by |E| =
 // |M Minv - I| = 8.9e-14, and 1 / |Minv w|^3 with that inverse makes the density 3 (E w).w = -8.3e-14 off.
