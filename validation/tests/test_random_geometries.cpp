@@ -190,9 +190,10 @@ TEST(KnownLimitations, ArvoIsOneExactlyOnLightsBelowAMicrosteradian) {
     EXPECT_EQ(limitation(far_cases, "polygon-solid-angle", scalar), "") << scalar;
   }
   const Registry r = default_registry();
-  for (const Case& c : r.cases())
+  for (const Case& c : r.cases()) {
     if (c.kernel == "baseline-arvo-triangle" && c.scalar != "float")
       EXPECT_EQ(!c.known_limitation.empty(), c.config == "far-1cm" || c.config == "far-1mm") << c.config;
+  }
 }
 
 // Peters 2021 Sec. 3 with two iterations: a known limitation where they leave the warp's density off by more than
@@ -218,7 +219,8 @@ TEST(KnownLimitations, ProjectedSolidAngleIsOneWhereTwoIterationsLeaveTheDensity
     }
   }
   const Registry r = default_registry();
-  for (const Case& c : r.cases())
+  for (const Case& c : r.cases()) {
     if (c.kernel == "polygon-projected-solid-angle" && c.scalar != "float")  // float: far-1mm's own limitation
       EXPECT_EQ(c.known_limitation, "") << c.scalar << " " << c.config;
+  }
 }
