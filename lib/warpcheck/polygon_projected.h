@@ -531,6 +531,38 @@ template <class T> T pdf_polygon_projected_solid_angle(const PolygonLightGeometr
   return pdf_polygon_projected_solid_angle(make_polygon_projected_view<T, false>(g), w);
 }
 
+// The inverse warp of the unbiased sampler: the u that sample_polygon_projected_solid_angle maps to w with an exact
+// inversion; false outside the support. u0 is the area from the first sector's start to w's azimuth over A_Sigma
+// (Eq. 1 for the central sector, Eq. 7's area between the ellipses for a decentral one), u1 inverts the radial
+// interpolation r^2 = (1 - u1) r_i^2 + u1 r_o^2 at that azimuth. The sampler's tangent-line iterations approximate
+// the first; an inversion stopped early shows as inverse(sample(u)) != u.
+template <class T>
+bool invert_polygon_projected_solid_angle(const PolygonProjectedView<T>& v, const Vec3<T>& w, Vec2<T>& u) {
+  if (!(pdf_polygon_projected_solid_angle(v, w) > T(0))) return false;
+  const Vec3<T> l = v.to_local(w / w.norm());
+  const Vec2<T> wxy(l.x(), l.y());
+  T before = 0;
+  for (int k = 0; k < v.sector_count; ++k) {
+    const ProjectedSector<T>& s = v.sectors[k];
+    if (!(s.area > T(0))) continue;
+    const bool last = k == v.sector_count - 1;
+    if (kahan_cross2(s.s0, wxy) < T(0) || (!last && kahan_cross2(wxy, s.s1) < T(0))) {
+      before += s.area;
+      continue;
+    }
+    T ri2 = 0, zi2 = 1, ro2, zo2;
+    const T to_w =
+        s.decentral ? decentral_area_to(s, wxy) : ellipse_sector_area(s.outer, s.s0, wxy, kahan_cross2(s.s0, wxy));
+    if (s.decentral) edge_boundary_point(s.inner, s.inner_a, s.inner_b, wxy, &ri2, &zi2);
+    edge_boundary_point(s.outer, s.outer_a, s.outer_b, wxy, &ro2, &zo2);
+    const T r2 = wxy.squaredNorm();
+    u[0] = std::clamp((before + std::clamp(to_w, T(0), s.area)) / v.projected_solid_angle, T(0), T(1));
+    u[1] = ro2 > ri2 ? std::clamp((r2 - ri2) / (ro2 - ri2), T(0), T(1)) : T(0.5);
+    return true;
+  }
+  return false;
+}
+
 // Section 6.4, the biased variant: no iteration, the approximate atan2. Its pdf is a renderer's, cos / A_Sigma with
 // the approximate A_Sigma; the samples' true density differs by the initialisation's error (the bias).
 template <class T>
@@ -557,6 +589,10 @@ template <class T, bool kBiased> struct PolygonProjectedSolidAngleKernel {
     return sample_polygon_projected_solid_angle<T, kBiased>(v, u, kBiased ? 0 : 2);
   }
   static T pdf(const View& v, const Vec3<T>& w) { return pdf_polygon_projected_solid_angle(v, w); }
+  // The unbiased sampler's inverse warp (the biased one's initialisation is not an inversion).
+  static bool invert(const View& v, const Vec3<T>& w, Vec2<T>& u) requires(!kBiased) {
+    return invert_polygon_projected_solid_angle(v, w, u);
+  }
   // The clipped polygon's vertices.
   static Cap<T> bounding_cap(const Geometry& g) {
     const View v = view(g);

@@ -614,6 +614,64 @@ template <class T> DirectionSample<T> sample_sptd_cap(const SptdCapView<T>& v, c
   return s;
 }
 
+namespace sptd_detail {
+
+// The inverse of uniform_cap_offset_local: u from the offset d = w_i - axis in the axis' frame (|d|^2 = 2 (1 - cos)).
+template <class T> Vec2<T> uniform_cap_offset_inverse(T cap_one_minus_cos, const Vec3<T>& d) {
+  const T phi = std::atan2(d.y(), d.x());
+  return Vec2<T>(d.squaredNorm() / (T(2) * std::min(T(2), cap_one_minus_cos)),
+                 (phi < T(0) ? phi + kTwoPi<T> : phi) / kTwoPi<T>);
+}
+
+// The inverse of sample_cosine_cap_direction at the unit w_i: u0 from R's area-CDF at x (from the upper tail's
+// area right of x where the sampler took it), u1 from y's place on R's chord at x, in the sampler's three forms.
+template <class T> Vec2<T> cosine_cap_inverse(const CosineCapView<T>& v, const Vec3<T>& wi) {
+  const T x = wi.dot(v.ex), y = wi.dot(v.ey);
+  if (v.ellipse_only) {
+    const T px = v.A > T(0) ? (x - v.xc) / v.A : T(0), py = v.sin_a > T(0) ? y / v.sin_a : T(0);
+    const T phi = std::atan2(py, px);
+    return Vec2<T>(px * px + py * py, (phi < T(0) ? phi + kTwoPi<T> : phi) / kTwoPi<T>);
+  }
+  const T x_full = v.cos_t >= T(0) ? v.x0 : v.xc + v.A;
+  const T u0 = x >= x_full ? T(1) - CosineCapView<T>::disk_right_of(x) / v.area : v.cdf(x) / v.area;
+  const T c = std::sqrt(std::max(T(0), (T(1) - x) * (T(1) + x)));
+  T s;
+  if (x >= x_full || (v.cos_t >= T(0) && x >= v.x0)) {
+    s = c > T(0) ? y / c : T(0);
+  } else {
+    const T m = v.tip ? v.crescent_chord(x - v.x0).m : std::min(c, v.ellipse_half_height(x));
+    if (v.cos_t >= T(0))
+      s = m > T(0) ? y / m : T(0);
+    else
+      s = c > m ? std::copysign((std::abs(y) - m) / (c - m), y) : T(0);
+  }
+  return Vec2<T>(std::clamp(u0, T(0), T(1)), std::clamp((s + T(1)) / T(2), T(0), T(1)));
+}
+
+}  // namespace sptd_detail
+
+// The inverse warp of sample_sptd_cap: w_i = g(w) (g is an involution, Eq. 3), then the base sampler's inverse;
+// false outside the support. The cosine base's u0 is R's closed-form area-CDF, which the sampler inverts by TOMS 748:
+// an inversion that stops early shows as inverse(sample(u)) != u.
+template <class T> bool invert_sptd_cap(const SptdCapView<T>& v, const Vec3<T>& w, Vec2<T>& u) {
+  if (!(pdf_sptd_cap(v, w) > T(0))) return false;
+  const Vec3<T> wu = w / w.norm();
+  const Frame<T> f = Frame<T>::from_z(v.image.axis);
+  if (v.image_relative) {
+    // As pdf_sptd_cap: w_i - axis = k o / |o|^2 - image_offset, o = pivot_offset(w).
+    const Vec3<T> o = pivot_offset(wu, v.sptd.pivot);
+    u = sptd_detail::uniform_cap_offset_inverse(v.image.one_minus_cos,
+                                                f.to_local(Vec3<T>((v.k / o.squaredNorm()) * o - v.image_offset)));
+  } else {
+    const Vec3<T> wi = pivot_transform(wu, v.sptd.pivot, v.k);
+    u = v.sptd.base == SptdBase::kUniform
+            ? sptd_detail::uniform_cap_offset_inverse(v.image.one_minus_cos, f.to_local(Vec3<T>(wi - v.image.axis)))
+            : sptd_detail::cosine_cap_inverse(v.cosine, wi);
+  }
+  u = Vec2<T>(std::clamp(u[0], T(0), T(1)), std::clamp(u[1], T(0), T(1)));
+  return true;
+}
+
 template <class T> DirectionSample<T> sample_sptd_cap(const SptdCapGeometry<T>& g, const Vec2<T>& u) {
   return sample_sptd_cap(make_sptd_cap_view(g), u);
 }
@@ -686,6 +744,7 @@ template <class T, SptdBase B> struct SptdCapKernel {
   }
   static DirectionSample<T> sample(const View& v, const Vec2<T>& u) { return sample_sptd_cap(v, u); }
   static T pdf(const View& v, const Vec3<T>& w) { return pdf_sptd_cap(v, w); }
+  static bool invert(const View& v, const Vec3<T>& w, Vec2<T>& u) { return invert_sptd_cap(v, w, u); }
   // The support lies in C.
   static Cap<T> bounding_cap(const Geometry& g) {
     Cap<T> c = g.cap;

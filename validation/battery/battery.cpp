@@ -34,6 +34,8 @@ BatteryOptions checked_options(const SamplerUnderTest& s, const BatteryOptions& 
   }
   if (s.uniforms < 2 || (s.uniforms > 2 && !s.sample_u))
     throw std::invalid_argument("SamplerUnderTest: uniforms >= 2, and sample_u for more than 2");
+  if (s.inverse && (s.uniforms != 2 || !s.sample))
+    throw std::invalid_argument("SamplerUnderTest: an inverse needs a sampler of two uniform numbers (sample)");
   if (!(s.bounding_cap.one_minus_cos > 0 && s.bounding_cap.one_minus_cos <= 2) || !all_finite(s.bounding_cap.axis))
     throw std::invalid_argument("SamplerUnderTest needs a bounding cap with 0 < 1 - cos(half-angle) <= 2");
   if (o.samples < 1000 || o.radial_bins < 1 || o.azimuth_bins < 1 || o.ks_cdf_nodes < 16)
@@ -47,7 +49,7 @@ BatteryOptions checked_options(const SamplerUnderTest& s, const BatteryOptions& 
 struct Prepared {
   Expected expected;
   std::shared_future<Real> outside;                         // the pdf's integral outside the bounding cap
-  std::shared_future<std::vector<TestResult>> independent;  // pdf-consistency and the normalisations
+  std::shared_future<std::vector<TestResult>> independent;  // pdf-consistency, normalisations, weight, round-trip
 };
 
 Prepared prepare(const SamplerUnderTest& s, const BatteryOptions& o) {
@@ -57,6 +59,7 @@ Prepared prepare(const SamplerUnderTest& s, const BatteryOptions& o) {
     std::vector<TestResult> r{pdf_consistency(s, o)};
     for (TestResult& n : normalizations(s)) r.push_back(std::move(n));
     if (s.eval) r.push_back(weight_check(s, o));
+    if (s.inverse) r.push_back(round_trip(s));
     return r;
   });
   if (o.progress) o.progress("quadrature", 0);

@@ -86,6 +86,9 @@ TestResult pdf_integral(const SamplerUnderTest& s, const BatteryOptions& o, cons
 TestResult pdf_consistency(const SamplerUnderTest& s, const BatteryOptions& o);
 // One result per declared Normalization.
 std::vector<TestResult> normalizations(const SamplerUnderTest& s);
+// For a sampler with an inverse (round_trip.cpp): inverse(sample(u)) == u on a 32 x 32 grid of u and
+// sample(inverse(w)) == w on a 32 x 32 grid of directions over the bounding cap, to s.inverse_tolerance in units of u.
+TestResult round_trip(const SamplerUnderTest& s);
 // For geometry that has no sample: every draw declines and the pdf is zero at random directions.
 TestResult no_sample(const SamplerUnderTest& s, const BatteryOptions& o);
 

@@ -266,7 +266,7 @@ template <template <class> class K, class T> SamplerUnderTest make_sampler(const
   n.kernel = [g = c.g.template cast<T>()] { return Real(K<T>::normaliser(K<T>::view(g))); };
   s.normalizations.push_back(n);
   if constexpr (std::is_same_v<T, float>) {
-    s.tolerance = float_tolerance(c.g);
+    s.tolerance = s.inverse_tolerance = float_tolerance(c.g);  // the round trip's in u alike
     s.tolerance_note = "float input rounding: 64 eps (1 + distance / size)";
   }
   return s;

@@ -77,10 +77,12 @@ std::vector<SptdConfig> sptd_configs() {
 
 // A priori rounding tolerance in float: the pivot transformation amplifies relative errors by up to
 // (1 + |r_p|) / (1 - |r_p|) (the ratio of the Jacobian's extremes, Eq. 4, to the power 1/2); 64 eps times that.
-// Double and long double keep the battery's 1e-6.
+// Double and long double keep the battery's 1e-6. The round trip's tolerance (in u) is the same bound: the inverse
+// sees a float direction whose rounding the pivot transformation amplified alike.
 template <class T> void set_tolerance(SamplerUnderTest& s, Real amplification, const char* note) {
   if constexpr (std::is_same_v<T, float>) {
     s.tolerance = std::max(1e-6L, 64 * Real(std::numeric_limits<float>::epsilon()) * amplification);
+    s.inverse_tolerance = s.tolerance;
     s.tolerance_note = note;
   }
 }

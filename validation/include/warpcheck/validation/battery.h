@@ -16,6 +16,8 @@
 //   pdf-consistency  max relative error between a sample's pdf, pdf(direction), and the inverse area element
 //                 of the (reference) warp by 4th-order central differences in long double (deterministic)
 //   normalization:<what>  relative error of each declared Normalization (deterministic)
+//   round-trip    for a sampler with an inverse: max error of inverse(sample(u)) == u and sample(inverse(w)) == w on
+//                 grids, in units of u (deterministic; skipped, no row, without an inverse)
 // Statistical tests (those with a p-value) are judged together by apply_correction: one significance level
 // alpha for the whole run, Sidak or Holm corrected across all its statistical tests. The results and their
 // JSON file: results.h; the power of the statistical tests against standard alternatives: power.h.

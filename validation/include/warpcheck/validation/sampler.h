@@ -20,6 +20,7 @@
 // everywhere, i.e. "no sample" geometry; the battery counts declined samples and fails on any).
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <concepts>
 #include <functional>
@@ -84,6 +85,16 @@ struct SamplerUnderTest {
   // must then carry weight == eval(direction) / pdf to `tolerance` (the test "weight").
   std::function<Real(const Vec3L&)> eval;
 
+  // Optional: the inverse warp, for a sampler of two uniform numbers: the primary sample (u0, u1) in [0, 1)^2 that
+  // `sample` maps to the unit direction w, or nullopt where w is outside the support. (A sampler of more uniform
+  // numbers picks a branch with the others; its inverse is not defined here.) With it the battery runs the
+  // deterministic test "round-trip": inverse(sample(u)) == u on a grid of u, and sample(inverse(w)) == w on a grid
+  // of directions over the bounding cap, both to inverse_tolerance. It catches an inversion in `sample` that stops
+  // early, which the statistical tests at 10^7 samples may not see.
+  std::function<std::optional<std::array<Real, 2>>(const Vec3L& w)> inverse;
+  // The round trip's tolerance in units of u: max |inverse(sample(u)) - u| over both coordinates; a direction's
+  // error is judged as the same error in u times the warp's local stretch |dw/du0| + |dw/du1|.
+  Real inverse_tolerance = 1e-6L;
   // Optional: membership in the support, used to flag samples outside the light. Default: pdf(w) > 0.
   std::function<bool(const Vec3L&)> in_support;
   // Optional: the same warp evaluated in higher precision, for the Jacobian check. Default: `sample`.
@@ -156,6 +167,23 @@ template <Kernel K> std::vector<Real> kernel_kinks(const typename K::Geometry& g
 
 template <class T> Vec3L to_long(const Vec3<T>& v) { return v.template cast<Real>(); }
 
+// A kernel's inverse warp (catalogue.h's invert(v, w, u)) on view v, as SamplerUnderTest::inverse; empty if K has
+// none. The tolerance is K::inverse_tolerance where K states one, else 1e-6 (double and long double); a float
+// kernel with an inverse must state its own.
+template <Kernel K> void bind_inverse(SamplerUnderTest& s, const typename K::View& v) {
+  using T = typename K::Scalar;
+  if constexpr (requires(const Vec3<T>& w, Vec2<T>& u) {
+                  { K::invert(v, w, u) } -> std::convertible_to<bool>;
+                }) {
+    s.inverse = [v](const Vec3L& w) -> std::optional<std::array<Real, 2>> {
+      Vec2<T> u(T(0), T(0));
+      if (!K::invert(v, w.template cast<T>(), u)) return std::nullopt;
+      return std::array<Real, 2>{Real(u[0]), Real(u[1])};
+    };
+    if constexpr (requires { K::inverse_tolerance; }) s.inverse_tolerance = Real(K::inverse_tolerance);
+  }
+}
+
 template <class T> constexpr const char* scalar_name() {
   if constexpr (std::is_same_v<T, float>)
     return "float";
@@ -201,7 +229,7 @@ template <Kernel K> std::vector<Cap<Real>> kernel_boundary_caps(const typename K
 }
 
 // Binds kernel K to geometry g (in K's scalar type; the caller converts it): sample and pdf on one view of g,
-// K's bounding cap, kinks, boundary planes and caps.
+// K's bounding cap, kinks, boundary planes and caps, and its inverse where it has one.
 template <Kernel K> SamplerUnderTest bind_kernel(std::string config, const typename K::Geometry& g) {
   using T = typename K::Scalar;
   SamplerUnderTest s;
@@ -225,6 +253,7 @@ template <Kernel K> SamplerUnderTest bind_kernel(std::string config, const typen
   s.kinks_u1 = kernel_kinks<K>(g, 1);
   s.boundary_planes = kernel_boundary_planes<K>(g);
   s.boundary_caps = kernel_boundary_caps<K>(g);
+  bind_inverse<K>(s, K::view(g));
   return s;
 }
 
