@@ -616,11 +616,15 @@ template <class T> DirectionSample<T> sample_sptd_cap(const SptdCapView<T>& v, c
 
 namespace sptd_detail {
 
+// The azimuth of (x, y) as a fraction of a turn, in [0, 1].
+template <class T> T azimuth_fraction(T y, T x) {
+  const T phi = std::atan2(y, x);
+  return (phi < T(0) ? phi + kTwoPi<T> : phi) / kTwoPi<T>;
+}
+
 // The inverse of uniform_cap_offset_local: u from the offset d = w_i - axis in the axis' frame (|d|^2 = 2 (1 - cos)).
 template <class T> Vec2<T> uniform_cap_offset_inverse(T cap_one_minus_cos, const Vec3<T>& d) {
-  const T phi = std::atan2(d.y(), d.x());
-  return Vec2<T>(d.squaredNorm() / (T(2) * std::min(T(2), cap_one_minus_cos)),
-                 (phi < T(0) ? phi + kTwoPi<T> : phi) / kTwoPi<T>);
+  return Vec2<T>(d.squaredNorm() / (T(2) * std::min(T(2), cap_one_minus_cos)), azimuth_fraction(d.y(), d.x()));
 }
 
 // The inverse of sample_cosine_cap_direction at the unit w_i: u0 from R's area-CDF at x (from the upper tail's
@@ -629,8 +633,7 @@ template <class T> Vec2<T> cosine_cap_inverse(const CosineCapView<T>& v, const V
   const T x = wi.dot(v.ex), y = wi.dot(v.ey);
   if (v.ellipse_only) {
     const T px = v.A > T(0) ? (x - v.xc) / v.A : T(0), py = v.sin_a > T(0) ? y / v.sin_a : T(0);
-    const T phi = std::atan2(py, px);
-    return Vec2<T>(px * px + py * py, (phi < T(0) ? phi + kTwoPi<T> : phi) / kTwoPi<T>);
+    return Vec2<T>(px * px + py * py, azimuth_fraction(py, px));
   }
   const T x_full = v.cos_t >= T(0) ? v.x0 : v.xc + v.A;
   const T u0 = x >= x_full ? T(1) - CosineCapView<T>::disk_right_of(x) / v.area : v.cdf(x) / v.area;
