@@ -47,9 +47,13 @@ template <class T> struct PolygonLight {
   }
 };
 
+template <class T> struct PreparedPolygonLight;
+
 template <class T> struct PolygonLightGeometry {
   ShadingPoint<T> shading;
   PolygonLight<T> light;
+  // Optional: prepare_polygon_light(light), made once per light. Used only while its vertices equal light's.
+  const PreparedPolygonLight<T>* prepared = nullptr;
 
   template <class U> PolygonLightGeometry<U> cast() const {
     return {ShadingPoint<U>{shading.position.template cast<U>(), shading.normal.template cast<U>()},
@@ -226,6 +230,47 @@ template <class T> NoSample check_polygon(const PolygonLight<T>& p, std::string*
   return polygon_check_detail::check_polygon_and_area(p, message, vertex_rounding, area2);
 }
 
+// ---- The light prepared once: the part of every view that does not depend on the shading point ----
+
+// check_polygon's verdict, Newell's vector and the light's edges in its plane (edge_in_plane, as
+// polygon_inward_planes takes them). A renderer prepares each light once and points PolygonLightGeometry::prepared
+// at it; every view of that light then skips the work, and its results are the same bit for bit.
+template <class T> struct PreparedPolygonLight {
+  PolygonLight<T> light;
+  T vertex_rounding = kPolygonVertexRounding<T>;
+  NoSample reason = NoSample::kInvalidGeometry;
+  Vec3<T> area2 = Vec3<T>::Zero();
+  std::array<Vec3<T>, kMaxPolygonVertices> edge{};  // V_j+1 - V_j in the plane, scaled by a power of two
+  std::array<bool, kMaxPolygonVertices> has_direction{};
+};
+
+template <class T>
+PreparedPolygonLight<T> prepare_polygon_light(const PolygonLight<T>& p, T vertex_rounding = kPolygonVertexRounding<T>) {
+  PreparedPolygonLight<T> r;
+  r.light = p;
+  r.vertex_rounding = vertex_rounding;
+  r.reason = polygon_check_detail::check_polygon_and_area(p, nullptr, vertex_rounding, r.area2);
+  if (r.reason != NoSample::kNone) return r;
+  const Vec3<T> nh = safe_normalized(r.area2);
+  auto rounding = [&](int k) { return vertex_rounding * p.vertices[k % p.count].cwiseAbs().maxCoeff(); };
+  for (int j = 0; j < p.count; ++j) {
+    T err;
+    const Vec3<T> e = p.vertices[(j + 1) % p.count] - p.vertices[j];
+    r.has_direction[j] = edge_in_plane<T>(e, rounding(j) + rounding(j + 1), nh, r.edge[j], err);
+  }
+  return r;
+}
+
+// g.prepared if it was made from g.light's vertices (compared exactly) with this vertex rounding, else null.
+template <class T>
+const PreparedPolygonLight<T>* matching_preparation(const PolygonLightGeometry<T>& g, T vertex_rounding) {
+  const PreparedPolygonLight<T>* p = g.prepared;
+  if (!p || p->light.count != g.light.count || p->vertex_rounding != vertex_rounding) return nullptr;
+  for (int i = 0; i < std::min(g.light.count, kMaxPolygonVertices); ++i)
+    if (p->light.vertices[i] != g.light.vertices[i]) return nullptr;
+  return p;
+}
+
 // ---- Clipping to the upper hemisphere (Peters 2021 Sec. 3.1) ----
 
 // A polygon of directions in a local frame (vertices need not be unit length; only their directions count).
@@ -279,9 +324,11 @@ PolygonView<T> make_polygon_view(const PolygonLightGeometry<T>& g, T vertex_roun
   if (!all_finite(g.shading.position)) return v.reason = NoSample::kNonFinite, v;
   if (!all_finite(g.shading.normal)) return v.reason = NoSample::kNonFinite, v;
   Vec3<T> area2;
-  if (const NoSample r = polygon_check_detail::check_polygon_and_area(g.light, nullptr, vertex_rounding, area2);
-      r != NoSample::kNone)
-    return v.reason = r, v;
+  const PreparedPolygonLight<T>* prep = matching_preparation(g, vertex_rounding);
+  const NoSample checked =
+      prep ? prep->reason : polygon_check_detail::check_polygon_and_area(g.light, nullptr, vertex_rounding, area2);
+  if (checked != NoSample::kNone) return v.reason = checked, v;
+  if (prep) area2 = prep->area2;
   if (!normalize_normal(g.shading.normal, v.normal)) return v.reason = NoSample::kBadNormal, v;
   v.frame = Frame<T>::from_z(v.normal);
   v.plane_normal = safe_normalized(area2);  // Newell's vector, as polygon_area_vector
@@ -334,13 +381,18 @@ template <class T> int polygon_inward_planes(const PolygonLightGeometry<T>& g, c
   const T orient = pv.plane_distance < T(0) ? T(-1) : T(1);
   const Vec3<T>& nh = pv.plane_normal;
   auto rounding = [&](int k) { return pv.vertex_rounding * g.light.vertices[k % n].cwiseAbs().maxCoeff(); };
+  const PreparedPolygonLight<T>* prep = matching_preparation(g, pv.vertex_rounding);
   std::array<bool, kMaxPolygonVertices> has_direction{};
   int last = -1;
   for (int j = 0; j < n; ++j) {
-    const Vec3<T> edge = g.light.vertices[(j + 1) % n] - g.light.vertices[j];
     Vec3<T> e;
-    T err;
-    has_direction[j] = edge_in_plane<T>(edge, rounding(j) + rounding(j + 1), nh, e, err);
+    if (prep) {
+      e = prep->edge[j], has_direction[j] = prep->has_direction[j];
+    } else {
+      T err;
+      const Vec3<T> edge = g.light.vertices[(j + 1) % n] - g.light.vertices[j];
+      has_direction[j] = edge_in_plane<T>(edge, rounding(j) + rounding(j + 1), nh, e, err);
+    }
     if (has_direction[j]) last = j;
     out[j] = orient * kahan_cross(Vec3<T>(g.light.vertices[j] - g.shading.position - pv.lift[j] * nh), e);
   }

@@ -6,6 +6,8 @@
 // the time per sample is 1 / items_per_second. "baseline" only reads the random numbers (and the geometry, for
 // spl=1): the papers subtract such a baseline (2019 Table 2; 2021 Table 1), and so does bench_table.
 // sphere-solid-angle/SCALAR/CONFIG/spl=500/batch is the batch API (batch.h) of the same kernel.
+// Polygon lights are prepared once (prepare_polygon_light, polygon.h), as a renderer does when it loads the scene;
+// POLYGON-KERNEL/SCALAR/CONFIG/spl=1/unprepared views the same lights without it (each view validates the light).
 //
 // Configurations, by the kernel's geometry:
 //  sphere  qz=Q     Peters & Dachsbacher 2019 Fig. 9 / Table 2: the plane z = 0 (normal +z) lit by a unit
@@ -26,6 +28,7 @@
 // Random numbers: pre-generated with std::mt19937_64 seed 1, as T, in [0, 1).
 #include <benchmark/benchmark.h>
 
+#include <list>
 #include <random>
 #include <string>
 #include <vector>
@@ -73,12 +76,15 @@ template <class T> std::vector<PolygonLightGeometry<T>> polygon_scene(int n, boo
     const double a = 2 * std::numbers::pi * k / n;
     light.vertices[k] = Vec3<T>(T(std::cos(a)), T(std::sin(a)), T(1));
   }
+  // Prepared once, as a renderer prepares its lights when it loads the scene; kept for the program's lifetime.
+  static std::list<PreparedPolygonLight<T>> prepared;
+  prepared.push_back(prepare_polygon_light(light));
   std::vector<PolygonLightGeometry<T>> out;
   for (int i = 0; i < kLights; ++i) {
     const double phi = 2 * std::numbers::pi * U(rng);
     const double rho = central ? 0.3 * std::sqrt(U(rng)) : 2 + 2 * U(rng);
     const Vec3<T> x(T(rho * std::cos(phi)), T(rho * std::sin(phi)), T(0));
-    out.push_back({ShadingPoint<T>{x, Vec3<T>(0, 0, 1)}, light});
+    out.push_back({ShadingPoint<T>{x, Vec3<T>(0, 0, 1)}, light, &prepared.back()});
   }
   return out;
 }
@@ -193,7 +199,13 @@ template <class T, class Light> std::string name(const char* kernel, const Scene
          "/spl=" + std::to_string(spl);
 }
 
-// Kernel K on every scene of its geometry, in both modes.
+// The polygon scene's lights without their preparation: every view validates the light again.
+template <class T> std::vector<PolygonLightGeometry<T>> unprepared(std::vector<PolygonLightGeometry<T>> lights) {
+  for (auto& g : lights) g.prepared = nullptr;
+  return lights;
+}
+
+// Kernel K on every scene of its geometry, in both modes; a polygon kernel also at 1 spl on unprepared lights.
 template <template <class> class K, class T> void register_kernel() {
   using G = typename K<T>::Geometry;
   using Light = typename SceneLight<G>::type;
@@ -204,6 +216,12 @@ template <template <class> class K, class T> void register_kernel() {
           name<T>(K<T>::name, scene, spl).c_str(), [spl, l = scene.lights](benchmark::State& s) {
             run<K, T>(
                 s, l, [](const Light& light) { return from_light(light, static_cast<const G*>(nullptr)); }, spl);
+          });
+    if constexpr (std::is_same_v<Light, PolygonLightGeometry<T>>)
+      benchmark::RegisterBenchmark(
+          (name<T>(K<T>::name, scene, 1) + "/unprepared").c_str(), [l = unprepared(scene.lights)](benchmark::State& s) {
+            run<K, T>(
+                s, l, [](const Light& light) { return from_light(light, static_cast<const G*>(nullptr)); }, 1);
           });
   }
 }

@@ -4,6 +4,7 @@
 // sample_polygon_solid_angle(g, u): not clipped). So what the battery validates is what users call only if the
 // two return the same direction and pdf, and pdf(direction) the same value, on every geometry: checked here on
 // random geometries of every family (the battery's own, random_geometries.cpp) in float, double and long double.
+// A polygon light prepared once (prepare_polygon_light) gives the same bits as one validated by every view.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -82,9 +83,24 @@ template <class T> void check_all(int count) {
         AGREE(BaselineArvoTriangle, sample_arvo_triangle_fan(g, u), pdf_arvo_triangle_fan(g, w));
         AGREE(BaselineTurkArea, sample_turk_area(g, u), pdf_turk_area(g, w));
         AGREE(BaselineUrenaRectangle, sample_spherical_rectangle(g, u), pdf_spherical_rectangle(g, w));
+        // The same calls on the light prepared once (prepare_polygon_light), as a renderer makes them.
+        const PreparedPolygonLight<T> prepared = prepare_polygon_light(g.light);
+        PolygonLightGeometry<T> gp = g;
+        gp.prepared = &prepared;
+        AGREE(PolygonProjectedSolidAngle, sample_polygon_projected_solid_angle(gp, u),
+              pdf_polygon_projected_solid_angle(gp, w));
+        AGREE(PolygonSolidAngle, sample_polygon_solid_angle(gp, u), pdf_polygon_solid_angle(gp, w));
+        AGREE(PolygonSolidAngleClipped, sample_polygon_solid_angle(gp, u, true), pdf_polygon_solid_angle(gp, w, true));
+        AGREE(BaselineArvoTriangle, sample_arvo_triangle_fan(gp, u), pdf_arvo_triangle_fan(gp, w));
+        AGREE(BaselineTurkArea, sample_turk_area(gp, u), pdf_turk_area(gp, w));
+        AGREE(BaselineUrenaRectangle, sample_spherical_rectangle(gp, u), pdf_spherical_rectangle(gp, w));
       } else if (t.family == "ltc") {
         const LtcPolygonGeometry<T> g = ltc_geometry(t).template cast<T>();
         AGREE(PolygonLtc, sample_ltc_polygon(g, u), pdf_ltc_polygon(g, w));
+        const PreparedPolygonLight<T> prepared = prepare_polygon_light(g.polygon.light);
+        LtcPolygonGeometry<T> gp = g;
+        gp.polygon.prepared = &prepared;
+        AGREE(PolygonLtc, sample_ltc_polygon(gp, u), pdf_ltc_polygon(gp, w));
       } else if (t.family == "sptd") {
         const SptdCapGeometry<T> g = sptd_geometry(t).template cast<T>();
         if (g.sptd.base == SptdBase::kUniform) {
@@ -102,6 +118,29 @@ template <class T> void check_all(int count) {
 TEST(EntryPoints, GeometryOverloadsAgreeWithTheBatterysTraitsBitForBitInFloat) { check_all<float>(4); }
 TEST(EntryPoints, GeometryOverloadsAgreeWithTheBatterysTraitsBitForBitInDouble) { check_all<double>(4); }
 TEST(EntryPoints, GeometryOverloadsAgreeWithTheBatterysTraitsBitForBitInLongDouble) { check_all<long double>(4); }
+
+// A preparation is used only for the light it was made from: a refused light's, attached to a valid light, changes
+// nothing; a refused light's own preparation refuses it for the same reason.
+TEST(EntryPoints, APolygonPreparationIsUsedOnlyForItsOwnLight) {
+  const PolygonLightGeometry<double> g{ShadingPoint<double>{Vec3<double>(0.3, 0.2, 0), Vec3<double>(0, 0, 1)},
+                                       PolygonLight<double>{{-1, -1, 1}, {1, -1, 1}, {1, 1, 1}, {-1, 1, 1}}};
+  PolygonLight<double> bow_tie = g.light;
+  std::swap(bow_tie.vertices[1], bow_tie.vertices[2]);
+  const PreparedPolygonLight<double> refused = prepare_polygon_light(bow_tie);
+  ASSERT_NE(refused.reason, NoSample::kNone);
+  PolygonLightGeometry<double> other = g;
+  other.prepared = &refused;
+  int valid = 0;
+  EXPECT_EQ(disagreements<PolygonSolidAngle<double>>(
+                g, [&](const auto& u) { return sample_polygon_solid_angle(other, u); },
+                [&](const auto& w) { return pdf_polygon_solid_angle(other, w); }, &valid),
+            0);
+  EXPECT_EQ(valid, 256);
+  PolygonLightGeometry<double> own{g.shading, bow_tie, &refused};
+  EXPECT_EQ(make_polygon_view(own).reason, refused.reason);
+  own.prepared = nullptr;
+  EXPECT_EQ(make_polygon_view(own).reason, refused.reason);
+}
 
 // The comparison sees an entry point that differs from the trait only in a default argument: one iteration of
 // Peters 2021's Newton-bisection instead of two.
