@@ -359,6 +359,21 @@ template <class T> Vec3<T> ldexp(const Vec3<T>& v, int e) {
   return Vec3<T>(std::ldexp(v.x(), e), std::ldexp(v.y(), e), std::ldexp(v.z(), e));
 }
 
+// |v| without overflow or underflow: m sqrt((x s)^2 + (y s)^2 + (z s)^2), m = max |v_i|, s = 1 / m (Eigen's
+// stableNorm of a vector taken as one block, its special cases included). Eigen's own stableNorm splits a 3-vector
+// into blocks by its address (alignment), which changes the rounding; this one does not depend on where v lies.
+template <class T> T stable_norm(const Vec3<T>& v) {
+  const T m = std::max(std::max(std::abs(v.x()), std::abs(v.y())), std::abs(v.z()));
+  if (m == T(0)) return T(0);
+  T inv = T(1) / m, scale = m;
+  if (inv > std::numeric_limits<T>::max())  // a subnormal m whose reciprocal overflows
+    inv = std::numeric_limits<T>::max(), scale = T(1) / inv;
+  else if (m > std::numeric_limits<T>::max())  // an infinite entry: Inf (or NaN)
+    inv = T(1);
+  const T a = v.x() * inv, b = v.y() * inv, c = v.z() * inv;
+  return scale * std::sqrt(a * a + b * b + c * c);
+}
+
 // Renormalises a direction that is a unit vector up to rounding (a sampler's output): one division and three
 // products instead of normalized()'s three divisions. Not for vectors that may be 0 or huge.
 template <class T> Vec3<T> renormalized(const Vec3<T>& v) { return v * (T(1) / v.norm()); }
@@ -373,7 +388,7 @@ template <class T> T near_unit_renormalization_factor(T n2) {
 // Normalises a shading normal; returns false for zero, subnormal-length or non-finite normals.
 template <class T> bool normalize_normal(const Vec3<T>& n, Vec3<T>& out) {
   if (!all_finite(n)) return false;
-  const T len = n.stableNorm();
+  const T len = stable_norm(n);
   if (!(len > std::numeric_limits<T>::min()) || !std::isfinite(len)) return false;
   out = n / len;
   return std::isfinite(out.x()) && std::isfinite(out.y()) && std::isfinite(out.z());

@@ -320,8 +320,8 @@ template <class T> bool resolved_by_coordinates(const PolygonLightGeometry<T>& g
   if (!(extent > T(64) * std::numeric_limits<T>::epsilon() * scale)) return false;
   T diameter = 0, nearest = std::numeric_limits<T>::infinity();
   for (int i = 0; i < g.light.count; ++i) {
-    diameter = std::max(diameter, T(2) * Vec3<T>(g.light.vertices[i] - g.light.vertices[0]).stableNorm());
-    nearest = std::min(nearest, Vec3<T>(g.light.vertices[i] - g.shading.position).stableNorm());
+    diameter = std::max(diameter, T(2) * stable_norm(Vec3<T>(g.light.vertices[i] - g.light.vertices[0])));
+    nearest = std::min(nearest, stable_norm(Vec3<T>(g.light.vertices[i] - g.shading.position)));
   }
   const T h = std::abs(pv.plane_distance), d = std::max(h, nearest - diameter);
   return diameter * (h / d) > T(64) * std::numeric_limits<T>::epsilon() * scale;

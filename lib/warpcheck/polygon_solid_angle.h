@@ -16,7 +16,7 @@ template <class T> struct PolygonFanView {
   std::array<Vec3<T>, kMaxFanVertices> p{};  // vertex - shading point
   std::array<Vec3<T>, kMaxFanVertices> e{};  // p_k - p_0, from the light's own vertices if unclipped
   std::array<Vec3<T>, kMaxFanVertices> u{};  // p_k / |p_k|
-  std::array<T, kMaxFanVertices> len{};      // |p_k| by stableNorm (norm() underflows for |p| < 1e-154)
+  std::array<T, kMaxFanVertices> len{};      // |p_k| by stable_norm (norm() underflows for |p| < 1e-154)
   // The cone {w : inward_j . w >= 0}: the light's edge planes, the horizon (clipped), and the plane through x
   // parallel to the light's (which excludes the antipodes a sliver's edge planes let in).
   std::array<Vec3<T>, kMaxFanVertices> inward{};
@@ -82,7 +82,7 @@ template <class T> bool fan_directions(PolygonFanView<T>& f, bool edges_from_p0)
   for (int k = 0; k < f.count; ++k) {
     if (edges_from_p0) f.e[k] = f.p[k] - f.p[0];
     f.u[k] = safe_normalized(f.p[k]);
-    f.len[k] = f.p[k].stableNorm();
+    f.len[k] = stable_norm(f.p[k]);
     if (f.u[k].isZero()) return false;
   }
   return true;

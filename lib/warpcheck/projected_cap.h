@@ -269,13 +269,13 @@ template <class T> void local_frame(ProjectedCapView<T>& p) {
   const T h_raw = p.z.dot(wd);
   const Vec3<T> horizontal = p.z.cross(Vec3<T>(wd.cross(p.z)));
   p.h = std::clamp(h_raw, T(-1), T(1));
-  p.w_dx = horizontal.stableNorm();
+  p.w_dx = stable_norm(horizontal);
   // Scaled to [1/2, 1) by a power of two first (exact), so that a subnormal horizontal part gives a unit x.
   if (p.w_dx > T(0)) {
     int ex = 0;
     std::frexp(horizontal.cwiseAbs().maxCoeff(), &ex);
     const Vec3<T> scaled = ldexp(horizontal, -ex);
-    p.x = scaled / scaled.stableNorm();
+    p.x = scaled / stable_norm(scaled);
   } else {
     p.x = Frame<T>::from_z(p.z).x;  // overhead: any horizontal x
   }

@@ -52,7 +52,7 @@ template <class T> SphereView<T> make_sphere_view(const SphereLightGeometry<T>& 
   if (r == T(0)) return v.reason = NoSample::kZeroSize, v;
   const Vec3<T> to_c = c - x;
   if (!all_finite(to_c)) return v.reason = NoSample::kNonFinite, v;  // the difference overflowed
-  const T d = to_c.stableNorm();
+  const T d = stable_norm(to_c);
   if (!std::isfinite(d)) return v.reason = NoSample::kNonFinite, v;
   if (d <= r) return v.reason = NoSample::kInsideLight, v;
   v.distance = d;
@@ -122,7 +122,7 @@ DirectionSample<T> sample_sphere_visible_area(const SphereView<T>& v, const Sphe
   T sin_phi, cos_phi;
   sine_cosine(phi, sin_phi, cos_phi);
   const Vec3<T> local(r * sin_a * cos_phi, r * sin_a * sin_phi, d - r * cos_a);
-  const T dist = local.stableNorm();
+  const T dist = stable_norm(local);
   // |p - x| beyond T's range (radius ~1e308): the density is not representable either. Tested before local / dist,
   // whose renormalisation would divide by zero.
   if (!std::isfinite(dist)) return DirectionSample<T>::none(NoSample::kTooSmall);

@@ -85,9 +85,9 @@ namespace sptd_detail {
 template <class T> Vec3<T> boundary_plane_direction(const Vec3<T>& wc, const Vec3<T>& rp) {
   Vec3<T> t = rp - rp.dot(wc) * wc;
   t -= t.dot(wc) * wc;
-  const T tn = t.stableNorm();
+  const T tn = stable_norm(t);
   constexpr T e = std::numeric_limits<T>::epsilon();
-  return tn > T(64) * e * rp.stableNorm() && tn > std::numeric_limits<T>::min() / e ? Vec3<T>(t / tn)
+  return tn > T(64) * e * stable_norm(rp) && tn > std::numeric_limits<T>::min() / e ? Vec3<T>(t / tn)
                                                                                     : Frame<T>::from_z(wc).x;
 }
 
