@@ -149,8 +149,9 @@ Real preimage_distance(const SamplerUnderTest& s, const std::array<Real, 2>& fro
 }
 
 // sample(inverse(w)) against w for the directions at the cell centres of an equal-area grid over the bounding cap
-// where the pdf is positive: the u-error J^+ (sample(u') - w) at u' = inverse(w), less the rounding's share. (A
-// support thinner than the grid's cells may hold none of them; the primary grid then checks alone.)
+// where the pdf is positive: the distance from u' = inverse(w) to w's preimage next to it (preimage_distance), less
+// the rounding's share. (A support thinner than the grid's cells may hold none of them; the primary grid then checks
+// alone.)
 Grid direction_grid(const SamplerUnderTest& s, Real same) {
   Grid g;
   for (int i = 0; i < kGrid; ++i)
