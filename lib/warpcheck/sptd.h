@@ -278,12 +278,22 @@ template <class T> CosineCapView<T> make_cosine_cap_view(const Cap<T>& cap, cons
   v.sin_a = std::sqrt(std::max(T(0), omc * (T(2) - omc)));
   v.ez = n;
   v.cos_t = std::clamp(cap.axis.dot(n), T(-1), T(1));
+  // e_x: the axis' part orthogonal to n, a difference known to an absolute ~eps, so that one pass leaves e_x . n ~
+  // eps / sin t. The frame must be orthonormal to rounding: x e_x + y e_y + z n is the sample at abscissa x only then
+  // (a tilt d = e_x . n shifts every sample by ~d, so the warp is not the density's). A second pass where |d| exceeds
+  // 4 eps; below sin t = 64 eps the axis is +-n to rounding (|d| could reach 1) and any frame about n serves.
   const Vec3<T> tangential = cap.axis - v.cos_t * n;
   v.sin_t = cap.axis.cross(n).norm();
-  if (v.sin_t > T(0) && tangential.norm() > T(0))
+  constexpr T eps = std::numeric_limits<T>::epsilon();
+  if (v.sin_t > T(64) * eps && tangential.norm() > T(0)) {
     v.ex = tangential / tangential.norm();
-  else
+    if (const T d = v.ex.dot(n); std::abs(d) > T(4) * eps) {
+      const Vec3<T> again = v.ex - d * n;
+      v.ex = again / again.norm();
+    }
+  } else {
     v.ex = Frame<T>::from_z(n).x, v.sin_t = T(0);
+  }
   v.ey = v.ez.cross(v.ex);
   v.xc = v.sin_t * v.cos_a;
   v.A = v.sin_a * std::abs(v.cos_t);
