@@ -7,7 +7,8 @@ ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 
 usage() {
   cat <<'EOF'
-Usage: scripts/mutants.sh [--only GLOB] [--samples N] [--random N] [--keep-going] [--resume] [--results FILE]
+Usage: scripts/mutants.sh [--only GLOB] [--samples N] [--random N] [--keep-going] [--stages LIST] [--resume]
+                          [--results FILE]
                           [--dir DIR] [--list] [--help]
 
 Applies each mutant validation/mutants/<family>-<name>.patch (a unified diff against lib/ or validation/battery/,
@@ -15,15 +16,16 @@ its first line "# slip: ..." saying what slip it models) to a scratch copy of HE
 detached, reset before every mutant; the working tree is never touched), builds it in one reused build directory
 DIR/tree/build (ccache), and runs the kill stages in order of cost:
 
-  1  the fuzz replays of the family's kernels (ctest fuzz_replay.*; one translation unit to build), then the
-     family's fast gtests (warpcheck_tests --gtest_filter: the family's suites and those on every kernel, see
-     family_suites in this script); a mutant that does not compile counts as killed by the compiler
+  1a the fuzz replays of the family's kernels (ctest fuzz_replay.*; one translation unit to build)
+  1b the family's fast gtests (warpcheck_tests --gtest_filter: the family's suites and those on every kernel, see
+     family_suites in this script)
   2  the rest of the default run that concerns the family: every fast gtest, every fuzz replay, and the family's
      share of battery.every_case (warpcheck validate --kernel <family's kernels> --samples 1000000; its
      Holm correction spans the family's tests only, not the whole registry's)
   3  the battery: warpcheck validate --kernel <family's kernels> --random R --samples N (the named
      configurations and R random geometries per family, as scripts/battery.sh runs them)
 
+A mutant that does not compile counts as killed by the compiler (every mutant here compiles with -Werror).
 A kernel mutant is killed by a battery stage when its run exits with a status other than 0 where the unmutated
 build's same run exits 0 (the unmutated runs are made once per family, stage and N, and kept in DIR/baseline/).
 A mutant of the battery (family "battery") is run on the negative controls and on sphere-solid-angle, and is
@@ -34,9 +36,12 @@ Options:
   --samples N     samples per case in stage 3 (default 10000000, the acceptance's 10^7; lower for a quick pass)
   --random N      random geometries per family in stage 3 (default 4)
   --keep-going    run every stage even after one kills (which stages see the mutant); the table names the first
-  --resume        skip the mutants that already have a result in the TSV file for the same patch and N
+  --stages LIST   run only these stages (comma-separated, of 1a,1b,2,3; default all): a quick pass; a mutant
+                  that none of them kills is "open", not a survivor, and does not count in the score
+  --resume        skip the mutants that already have a result in the TSV file for the same patch (and the same N
+                  when the result came from stage 3); an "open" result is run again
   --results FILE  the TSV file results are appended to (default DIR/results.tsv): mutant, patch sha1, samples,
-                  outcome (killed/survived/error), stage (1-3 or -), what killed it, seconds, UTC time
+                  outcome (killed/survived/open), stage (1a, 1b, 2, 3 or -), what killed it, seconds, UTC time
   --dir DIR       scratch directory (default build-mutants/ in the clone, ignored by git)
   --list          list the mutants and their slips, run nothing
   --help          this text
@@ -49,13 +54,20 @@ EOF
 
 die() { echo "mutants.sh: $*" >&2; exit 2; }
 
-ONLY=() SAMPLES=10000000 RANDOM_N=4 KEEP_GOING=0 RESUME=0 RESULTS="" DIR="$ROOT/build-mutants" LIST=0
+ALL_STAGES="1a 1b 2 3"
+ONLY=() STAGES="$ALL_STAGES" SAMPLES=10000000 RANDOM_N=4 KEEP_GOING=0 RESUME=0 RESULTS="" DIR="$ROOT/build-mutants" LIST=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --only) [ $# -ge 2 ] || die "--only needs a glob"; ONLY+=("$2"); shift 2 ;;
     --samples) [[ "${2:-}" =~ ^[0-9]+$ ]] || die "--samples needs a positive integer"; SAMPLES="$2"; shift 2 ;;
     --random) [[ "${2:-}" =~ ^[0-9]+$ ]] || die "--random needs a non-negative integer"; RANDOM_N="$2"; shift 2 ;;
     --keep-going) KEEP_GOING=1; shift ;;
+    --stages)
+      [ $# -ge 2 ] || die "--stages needs a list"
+      STAGES=""
+      for s in $ALL_STAGES; do [[ ",$2," == *",$s,"* ]] && STAGES="$STAGES${STAGES:+ }$s"; done
+      for s in ${2//,/ }; do [[ " $ALL_STAGES " == *" $s "* ]] || die "--stages: unknown stage '$s' (1a,1b,2,3)"; done
+      shift 2 ;;
     --resume) RESUME=1; shift ;;
     --results) [ $# -ge 2 ] || die "--results needs a file"; RESULTS="$2"; shift 2 ;;
     --dir) [ $# -ge 2 ] || die "--dir needs a directory"; DIR="$2"; shift 2 ;;
@@ -156,7 +168,9 @@ battery_run() {
   local family="$1" out="$2" samples="$3" random="$4" args=() k status=0
   for k in $(family_kernels "$family"); do args+=(--kernel "$k"); done
   [ "$random" -gt 0 ] && args+=(--random "$random")
-  "$BUILD/warpcheck" validate "${args[@]}" --samples "$samples" --quiet >"$out.table" 2>"$out.err" || status=$?
+  # The JSON carries each case's power figures (the smallest error the run would catch), for a survivor's reason.
+  "$BUILD/warpcheck" validate "${args[@]}" --samples "$samples" --quiet --json "$out.json" >"$out.table" 2>"$out.err" ||
+    status=$?
   if [ "$family" = battery ]; then  # and the negative controls, which must keep failing
     local s2=0
     "$BUILD/warpcheck" validate --negative-controls --samples "$samples" --quiet >>"$out.table" 2>>"$out.err" || s2=$?
@@ -169,7 +183,9 @@ battery_run() {
 # Verdict of a battery stage: compares the mutant's run with the unmutated build's (made once, kept in baseline/).
 battery_stage() {
   local family="$1" stage="$2" samples="$3" random="$4" m="$5"
-  local base="$DIR/baseline/$family-s$stage-n$samples-r$random-$HEAD_SHA" mut="$DIR/logs/$m-s$stage"
+  local base="$DIR/baseline/$family-s$stage-n$samples-r$random-$HEAD_SHA" mut="$DIR/logs/$m-s$stage" what
+  what="$(build_or_kill "$m" warpcheck)"
+  [ -z "$what" ] || { echo "$what"; return; }
   battery_run "$family" "$mut" "$samples" "$random"
   # A kernel mutant whose run passes survives the stage whatever the unmutated run does: no baseline needed.
   [ "$family" != battery ] && [ "$(cat "$mut.status")" = 0 ] && return
@@ -188,10 +204,10 @@ battery_stage() {
 }
 # A mutant that does not compile is killed by the compiler (every mutant here compiles with -Werror).
 build_or_kill() { build "$DIR/logs/$1-build.log" "${@:2}" || echo "build: $(grep -m1 'error' "$DIR/logs/$1-build.log" | cut -c1-120)"; }
-stage1() {
-  local family="$1" m="$2" log="$DIR/logs/$m-s1.log" k f what
+# Stage 1a: the family's fuzz replays (one translation unit to build).
+stage1a() {
+  local family="$1" m="$2" log="$DIR/logs/$m-s1a.log" k f what
   : >"$log"
-  # The fuzz replays first: one translation unit to build.
   what="$(build_or_kill "$m" warpcheck_fuzz_replay)"
   [ -z "$what" ] || { echo "$what"; return; }
   for k in $(family_fuzz "$family"); do
@@ -199,20 +215,24 @@ stage1() {
       (cd "$BUILD" && ctest -R "^fuzz_replay\.fuzz_${k}_${f}\$" >>"$log" 2>&1) || { echo "fuzz_replay.fuzz_${k}_$f"; return; }
     done
   done
+}
+# Stage 1b: the family's fast gtests.
+stage1b() {
+  local family="$1" m="$2" log="$DIR/logs/$m-s1b.log" what
   what="$(build_or_kill "$m" warpcheck_tests)"
   [ -z "$what" ] || { echo "$what"; return; }
-  "$BUILD/warpcheck_tests" --gtest_filter="$(family_suites "$family")" >>"$log" 2>&1 ||
+  "$BUILD/warpcheck_tests" --gtest_filter="$(family_suites "$family")" >"$log" 2>&1 ||
     { echo "gtest: $(sed -nE 's/^\[  FAILED  \] ([^ ]+).*/\1/p' "$log" | head -1)"; return; }
 }
 stage2() {
   local family="$1" m="$2" log="$DIR/logs/$m-s2.log"
+  local what
+  what="$(build_or_kill "$m" warpcheck_tests warpcheck_fuzz_replay)"
+  [ -z "$what" ] || { echo "$what"; return; }
   "$BUILD/warpcheck_tests" >"$log" 2>&1 ||
     { echo "gtest: $(sed -nE 's/^\[  FAILED  \] ([^ ]+).*/\1/p' "$log" | head -1)"; return; }
   (cd "$BUILD" && ctest -R '^fuzz_replay\.' -j "$JOBS" >>"$log" 2>&1) ||
     { echo "$(sed -nE 's/.*- (fuzz_replay\.[^ ]+) \(Failed\).*/\1/p' "$log" | head -1)"; return; }
-  local what
-  what="$(build_or_kill "$m" warpcheck)"
-  [ -z "$what" ] || { echo "$what"; return; }
   battery_stage "$family" 2 1000000 0 "$m"
 }
 stage3() { battery_stage "$1" 3 "$SAMPLES" "$RANDOM_N" "$2"; }
@@ -223,22 +243,27 @@ declare -A ROW
 if [ $RESUME = 1 ]; then
   while IFS=$'\t' read -r name sha n outcome stage by secs utc; do
     [ "$name" = mutant ] && continue
+    # A kill before the battery stage does not depend on N.
+    [ "$outcome" = open ] && continue
+    [ "$outcome" = killed ] && [ "$stage" != 3 ] && n=any
     ROW["$name $sha $n"]="$outcome	$stage	$by	$secs"
   done <"$RESULTS"
 fi
 printf '%-34s %-9s %-6s %8s  %s\n' mutant outcome stage seconds "killed by"
-killed=0 total=0
+killed=0 total=0 open=0
 for m in "${SELECTED[@]}"; do
   family="${m%%-*}" patch="$ROOT/validation/mutants/$m.patch"
   sha="$(sha1sum "$patch" | cut -c1-12)"
-  if [ $RESUME = 1 ] && [ -n "${ROW["$m $sha $SAMPLES"]:-}" ]; then
-    IFS=$'\t' read -r outcome stage by secs <<<"${ROW["$m $sha $SAMPLES"]}"
+  key="$m $sha $SAMPLES"
+  [ -n "${ROW["$m $sha any"]:-}" ] && key="$m $sha any"
+  if [ $RESUME = 1 ] && [ -n "${ROW["$key"]:-}" ]; then
+    IFS=$'\t' read -r outcome stage by secs <<<"${ROW["$key"]}"
   else
     start=$(date +%s) outcome=survived stage=- by=""
     reset_tree
     git -C "$TREE" apply "$patch"
     : >"$DIR/logs/$m-build.log"
-    for s in 1 2 3; do
+    for s in $STAGES; do
       what="$(stage$s "$family" "$m")"
       if [ -n "$what" ]; then
         if [ "$outcome" = killed ]; then
@@ -249,15 +274,17 @@ for m in "${SELECTED[@]}"; do
         [ $KEEP_GOING = 1 ] || break
       fi
     done
+    [ "$outcome" = killed ] || [ "$STAGES" = "$ALL_STAGES" ] || outcome=open
     secs=$(($(date +%s) - start))
     printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$m" "$sha" "$SAMPLES" "$outcome" "$stage" "${by//$'\t'/ }" "$secs" \
       "$(date -u +%FT%TZ)" >>"$RESULTS"
   fi
-  total=$((total + 1))
+  [ "$outcome" = open ] && open=$((open + 1)) || total=$((total + 1))
   [ "$outcome" = killed ] && killed=$((killed + 1))
   printf '%-34s %-9s %-6s %8s  %s\n' "$m" "$outcome" "$stage" "$secs" "$by"
 done
 reset_tree
 echo
-echo "mutation score: $killed of $total killed ($(awk -v k=$killed -v t=$total 'BEGIN { printf "%.1f", 100 * k / t }')%)," \
-  "battery stage at $SAMPLES samples, --random $RANDOM_N; results in $RESULTS"
+echo "mutation score: $killed of $total killed ($(awk -v k=$killed -v t=$total 'BEGIN { if (t) printf "%.1f", 100 * k / t; else printf "-" }')%)," \
+  "stages $STAGES, battery stage at $SAMPLES samples, --random $RANDOM_N; $open open (not killed by the stages run);" \
+  "results in $RESULTS"
