@@ -212,7 +212,7 @@ stage1a() {
   [ -z "$what" ] || { echo "$what"; return; }
   for k in $(family_fuzz "$family"); do
     for f in float double; do
-      (cd "$BUILD" && ctest -R "^fuzz_replay\.fuzz_${k}_${f}\$" >>"$log" 2>&1) || { echo "fuzz_replay.fuzz_${k}_$f"; return; }
+      (cd "$BUILD" && ctest --output-on-failure -R "^fuzz_replay\.fuzz_${k}_${f}\$" >>"$log" 2>&1) || { echo "fuzz_replay.fuzz_${k}_$f"; return; }
     done
   done
 }
@@ -231,7 +231,7 @@ stage2() {
   [ -z "$what" ] || { echo "$what"; return; }
   "$BUILD/warpcheck_tests" >"$log" 2>&1 ||
     { echo "gtest: $(sed -nE 's/^\[  FAILED  \] ([^ ]+).*/\1/p' "$log" | head -1)"; return; }
-  (cd "$BUILD" && ctest -R '^fuzz_replay\.' -j "$JOBS" >>"$log" 2>&1) ||
+  (cd "$BUILD" && ctest --output-on-failure -R '^fuzz_replay\.' -j "$JOBS" >>"$log" 2>&1) ||
     { echo "$(sed -nE 's/.*- (fuzz_replay\.[^ ]+) \(Failed\).*/\1/p' "$log" | head -1)"; return; }
   battery_stage "$family" 2 1000000 0 "$m"
 }
