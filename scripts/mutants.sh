@@ -120,6 +120,7 @@ SELECTED=()
 for m in "${ALL[@]}"; do
   if [ ${#ONLY[@]} -gt 0 ]; then
     hit=0
+    # shellcheck disable=SC2053 # $g is a glob
     for g in "${ONLY[@]}"; do [[ "$m" == $g ]] && hit=1; done
     [ $hit = 1 ] || continue
   fi
@@ -206,7 +207,8 @@ battery_stage() {
 build_or_kill() { build "$DIR/logs/$1-build.log" "${@:2}" || echo "build: $(grep -m1 'error' "$DIR/logs/$1-build.log" | cut -c1-120)"; }
 # Stage 1a: the family's fuzz replays (one translation unit to build).
 stage1a() {
-  local family="$1" m="$2" log="$DIR/logs/$m-s1a.log" k f what
+  local family="$1" m="$2" k f what
+  local log="$DIR/logs/$m-s1a.log"
   : >"$log"
   what="$(build_or_kill "$m" warpcheck_fuzz_replay)"
   [ -z "$what" ] || { echo "$what"; return; }
@@ -218,14 +220,16 @@ stage1a() {
 }
 # Stage 1b: the family's fast gtests.
 stage1b() {
-  local family="$1" m="$2" log="$DIR/logs/$m-s1b.log" what
+  local family="$1" m="$2" what
+  local log="$DIR/logs/$m-s1b.log"
   what="$(build_or_kill "$m" warpcheck_tests)"
   [ -z "$what" ] || { echo "$what"; return; }
   "$BUILD/warpcheck_tests" --gtest_filter="$(family_suites "$family")" >"$log" 2>&1 ||
     { echo "gtest: $(sed -nE 's/^\[  FAILED  \] ([^ ]+).*/\1/p' "$log" | head -1)"; return; }
 }
 stage2() {
-  local family="$1" m="$2" log="$DIR/logs/$m-s2.log"
+  local family="$1" m="$2"
+  local log="$DIR/logs/$m-s2.log"
   local what
   what="$(build_or_kill "$m" warpcheck_tests warpcheck_fuzz_replay)"
   [ -z "$what" ] || { echo "$what"; return; }
@@ -241,7 +245,7 @@ stage3() { battery_stage "$1" 3 "$SAMPLES" "$RANDOM_N" "$2"; }
 [ -f "$RESULTS" ] || printf 'mutant\tpatch_sha1\tsamples\toutcome\tstage\tkilled_by\tseconds\tutc\n' >"$RESULTS"
 declare -A ROW
 if [ $RESUME = 1 ]; then
-  while IFS=$'\t' read -r name sha n outcome stage by secs utc; do
+  while IFS=$'\t' read -r name sha n outcome stage by secs _; do
     [ "$name" = mutant ] && continue
     # A kill before the battery stage does not depend on N.
     [ "$outcome" = open ] && continue
