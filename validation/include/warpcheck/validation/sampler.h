@@ -93,7 +93,8 @@ struct SamplerUnderTest {
   // early, which the statistical tests at 10^7 samples may not see.
   std::function<std::optional<std::array<Real, 2>>(const Vec3L& w)> inverse;
   // The round trip's tolerance in units of u: max |inverse(sample(u)) - u| over both coordinates; a direction's
-  // error sample(inverse(w)) - w is taken to u through the warp's local Jacobian dw/du (least squares).
+  // error sample(inverse(w)) - w is taken to u as the distance from inverse(w) to w's nearest preimage under
+  // `sample`, found by Gauss-Newton steps with the warp's Jacobian dw/du (least squares).
   Real inverse_tolerance = 1e-6L;
   // Optional: membership in the support, used to flag samples outside the light. Default: pdf(w) > 0.
   std::function<bool(const Vec3L&)> in_support;
