@@ -7,7 +7,9 @@
 # Writes coverage/{tests,battery}.json (gcovr's JSON), coverage/summary.md (the table per kernel header for the
 # README) and coverage/untaken.md (the branches of lib/'s sample and pdf functions that the battery never takes).
 # Usage: scripts/coverage.sh [--random N] [--samples N]; BUILD_DIR (default build-coverage). Takes long: a
-# separate unoptimised-ish build (-O1) of the tests and the CLI, then both runs under gcov's counters.
+# separate unoptimised-ish build (-O1) of the tests and the CLI, then both runs under gcov's counters. The counters
+# are updated atomically: the battery's threads otherwise race on them, and gcov then reports negative counts that
+# gcovr refuses.
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD="${BUILD_DIR:-$ROOT/build-coverage}"
@@ -23,7 +25,7 @@ while [ $# -gt 0 ]; do
 done
 command -v gcovr >/dev/null || { echo "[coverage] installing gcovr"; apt-get install -y -q gcovr >/dev/null; }
 
-cmake -S "$ROOT" -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=None -DCMAKE_CXX_FLAGS="-O1 -g --coverage" \
+cmake -S "$ROOT" -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=None -DCMAKE_CXX_FLAGS="-O1 -g --coverage -fprofile-update=atomic" \
   -DCMAKE_EXE_LINKER_FLAGS=--coverage -DWARPCHECK_WARNINGS_AS_ERRORS=OFF -DCMAKE_CXX_COMPILER_LAUNCHER=ccache >/dev/null
 ninja -C "$BUILD" -j"${JOBS:-2}" warpcheck warpcheck_tests warpcheck_fuzz_replay warpcheck_fuzz_tests
 mkdir -p "$OUT"
