@@ -123,9 +123,10 @@ bool replay_polygon_backward(const SearchRecord& r, int iterations) {
   }
   const std::optional<L> now = polygon_backward_error(r.best_x, iterations);
   EXPECT_TRUE(now) << "the kernel declined the polygon of the recorded sector";
-  if (now)
+  if (now) {
     EXPECT_NEAR(*now, r.best_f, 1e-9L * r.best_f + 64 * std::numeric_limits<L>::epsilon())
         << "recorded " << double(r.best_f) << ", through the kernel " << double(*now);
+  }
   return true;
 }
 
