@@ -74,26 +74,23 @@ template <class T> void check_all(int count) {
               (pdf_projected_spherical_cap<T, CutDiskInverse::kExact>(g, w)));
       } else if (t.family == "polygon" || t.family == "rectangle") {
         const PolygonLightGeometry<T> g = polygon_geometry(t).template cast<T>();
-        AGREE(PolygonProjectedSolidAngle, sample_polygon_projected_solid_angle(g, u),
-              pdf_polygon_projected_solid_angle(g, w));
-        AGREE(PolygonProjectedSolidAngleBiased, sample_polygon_projected_solid_angle_biased(g, u),
-              pdf_polygon_projected_solid_angle_biased(g, w));
-        AGREE(PolygonSolidAngle, sample_polygon_solid_angle(g, u), pdf_polygon_solid_angle(g, w));
-        AGREE(PolygonSolidAngleClipped, sample_polygon_solid_angle(g, u, true), pdf_polygon_solid_angle(g, w, true));
-        AGREE(BaselineArvoTriangle, sample_arvo_triangle_fan(g, u), pdf_arvo_triangle_fan(g, w));
-        AGREE(BaselineTurkArea, sample_turk_area(g, u), pdf_turk_area(g, w));
-        AGREE(BaselineUrenaRectangle, sample_spherical_rectangle(g, u), pdf_spherical_rectangle(g, w));
-        // The same calls on the light prepared once (prepare_polygon_light), as a renderer makes them.
+        // The calls on `call` against the traits on g: first g itself, then g with its light prepared once
+        // (prepare_polygon_light), as a renderer makes them.
         const PreparedPolygonLight<T> prepared = prepare_polygon_light(g.light);
         PolygonLightGeometry<T> gp = g;
         gp.prepared = &prepared;
-        AGREE(PolygonProjectedSolidAngle, sample_polygon_projected_solid_angle(gp, u),
-              pdf_polygon_projected_solid_angle(gp, w));
-        AGREE(PolygonSolidAngle, sample_polygon_solid_angle(gp, u), pdf_polygon_solid_angle(gp, w));
-        AGREE(PolygonSolidAngleClipped, sample_polygon_solid_angle(gp, u, true), pdf_polygon_solid_angle(gp, w, true));
-        AGREE(BaselineArvoTriangle, sample_arvo_triangle_fan(gp, u), pdf_arvo_triangle_fan(gp, w));
-        AGREE(BaselineTurkArea, sample_turk_area(gp, u), pdf_turk_area(gp, w));
-        AGREE(BaselineUrenaRectangle, sample_spherical_rectangle(gp, u), pdf_spherical_rectangle(gp, w));
+        for (const PolygonLightGeometry<T>* call : std::initializer_list<const PolygonLightGeometry<T>*>{&g, &gp}) {
+          const PolygonLightGeometry<T>& c = *call;
+          AGREE(PolygonProjectedSolidAngle, sample_polygon_projected_solid_angle(c, u),
+                pdf_polygon_projected_solid_angle(c, w));
+          AGREE(PolygonProjectedSolidAngleBiased, sample_polygon_projected_solid_angle_biased(c, u),
+                pdf_polygon_projected_solid_angle_biased(c, w));
+          AGREE(PolygonSolidAngle, sample_polygon_solid_angle(c, u), pdf_polygon_solid_angle(c, w));
+          AGREE(PolygonSolidAngleClipped, sample_polygon_solid_angle(c, u, true), pdf_polygon_solid_angle(c, w, true));
+          AGREE(BaselineArvoTriangle, sample_arvo_triangle_fan(c, u), pdf_arvo_triangle_fan(c, w));
+          AGREE(BaselineTurkArea, sample_turk_area(c, u), pdf_turk_area(c, w));
+          AGREE(BaselineUrenaRectangle, sample_spherical_rectangle(c, u), pdf_spherical_rectangle(c, w));
+        }
       } else if (t.family == "ltc") {
         const LtcPolygonGeometry<T> g = ltc_geometry(t).template cast<T>();
         AGREE(PolygonLtc, sample_ltc_polygon(g, u), pdf_ltc_polygon(g, w));
