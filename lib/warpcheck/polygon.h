@@ -232,6 +232,19 @@ template <class T> NoSample check_polygon(const PolygonLight<T>& p, std::string*
 
 // ---- The light prepared once: the part of every view that does not depend on the shading point ----
 
+// The light's edges V_j+1 - V_j in the plane of unit normal nh (edge_in_plane: scaled by a power of two), and
+// whether each is longer than its ends' rounding, vertex_rounding |V_k|_inf each.
+template <class T> void polygon_edges_in_plane(const PolygonLight<T>& p, const Vec3<T>& nh, T vertex_rounding,
+                                               std::array<Vec3<T>, kMaxPolygonVertices>& edge,
+                                               std::array<bool, kMaxPolygonVertices>& has_direction) {
+  auto rounding = [&](int k) { return vertex_rounding * p.vertices[k % p.count].cwiseAbs().maxCoeff(); };
+  for (int j = 0; j < p.count; ++j) {
+    T err;
+    const Vec3<T> e = p.vertices[(j + 1) % p.count] - p.vertices[j];
+    has_direction[j] = edge_in_plane<T>(e, rounding(j) + rounding(j + 1), nh, edge[j], err);
+  }
+}
+
 // check_polygon's verdict, Newell's vector and the light's edges in its plane (edge_in_plane, as
 // polygon_inward_planes takes them). A renderer prepares each light once and points PolygonLightGeometry::prepared
 // at it; every view of that light then skips the work, and its results are the same bit for bit.
@@ -251,13 +264,7 @@ PreparedPolygonLight<T> prepare_polygon_light(const PolygonLight<T>& p, T vertex
   r.vertex_rounding = vertex_rounding;
   r.reason = polygon_check_detail::check_polygon_and_area(p, nullptr, vertex_rounding, r.area2);
   if (r.reason != NoSample::kNone) return r;
-  const Vec3<T> nh = safe_normalized(r.area2);
-  auto rounding = [&](int k) { return vertex_rounding * p.vertices[k % p.count].cwiseAbs().maxCoeff(); };
-  for (int j = 0; j < p.count; ++j) {
-    T err;
-    const Vec3<T> e = p.vertices[(j + 1) % p.count] - p.vertices[j];
-    r.has_direction[j] = edge_in_plane<T>(e, rounding(j) + rounding(j + 1), nh, r.edge[j], err);
-  }
+  polygon_edges_in_plane(p, safe_normalized(r.area2), vertex_rounding, r.edge, r.has_direction);
   return r;
 }
 
@@ -312,7 +319,8 @@ template <class T> struct PolygonView {
   // `local` vertices are V_k - x - lift[k] plane_normal.
   std::array<T, kMaxPolygonVertices> lift{};
   bool flattened = false;
-  T vertex_rounding = kPolygonVertexRounding<T>;  // as passed to check_polygon (make_polygon_view)
+  T vertex_rounding = kPolygonVertexRounding<T>;      // as passed to check_polygon (make_polygon_view)
+  const PreparedPolygonLight<T>* prepared = nullptr;  // the geometry's preparation where it matches its light
   bool valid() const { return reason == NoSample::kNone; }
 };
 
@@ -324,7 +332,7 @@ PolygonView<T> make_polygon_view(const PolygonLightGeometry<T>& g, T vertex_roun
   if (!all_finite(g.shading.position)) return v.reason = NoSample::kNonFinite, v;
   if (!all_finite(g.shading.normal)) return v.reason = NoSample::kNonFinite, v;
   Vec3<T> area2;
-  const PreparedPolygonLight<T>* prep = matching_preparation(g, vertex_rounding);
+  const PreparedPolygonLight<T>* prep = v.prepared = matching_preparation(g, vertex_rounding);
   const NoSample checked =
       prep ? prep->reason : polygon_check_detail::check_polygon_and_area(g.light, nullptr, vertex_rounding, area2);
   if (checked != NoSample::kNone) return v.reason = checked, v;
@@ -375,26 +383,21 @@ PolygonView<T> make_polygon_view(const PolygonLightGeometry<T>& g, T vertex_roun
 
 // The planes (V_j - x) x (V_{j+1} - V_j) through x and the light's edges, oriented inwards: w is in the light's cone
 // iff all dot products are >= 0. From exact world edges taken in the light's plane (edge_in_plane); an edge without
-// a direction takes the plane before it. Returns the number of planes, g.light.count.
+// a direction takes the plane before it; pv is g's view (its preparation's edges when it has one). Returns the number
+// of planes, g.light.count.
 template <class T> int polygon_inward_planes(const PolygonLightGeometry<T>& g, const PolygonView<T>& pv, Vec3<T>* out) {
   const int n = g.light.count;
   const T orient = pv.plane_distance < T(0) ? T(-1) : T(1);
   const Vec3<T>& nh = pv.plane_normal;
-  auto rounding = [&](int k) { return pv.vertex_rounding * g.light.vertices[k % n].cwiseAbs().maxCoeff(); };
-  const PreparedPolygonLight<T>* prep = matching_preparation(g, pv.vertex_rounding);
-  std::array<bool, kMaxPolygonVertices> has_direction{};
+  std::array<Vec3<T>, kMaxPolygonVertices> own_edge;
+  std::array<bool, kMaxPolygonVertices> own_has_direction{};
+  if (!pv.prepared) polygon_edges_in_plane(g.light, nh, pv.vertex_rounding, own_edge, own_has_direction);
+  const auto& edge = pv.prepared ? pv.prepared->edge : own_edge;
+  const auto& has_direction = pv.prepared ? pv.prepared->has_direction : own_has_direction;
   int last = -1;
   for (int j = 0; j < n; ++j) {
-    Vec3<T> e;
-    if (prep) {
-      e = prep->edge[j], has_direction[j] = prep->has_direction[j];
-    } else {
-      T err;
-      const Vec3<T> edge = g.light.vertices[(j + 1) % n] - g.light.vertices[j];
-      has_direction[j] = edge_in_plane<T>(edge, rounding(j) + rounding(j + 1), nh, e, err);
-    }
     if (has_direction[j]) last = j;
-    out[j] = orient * kahan_cross(Vec3<T>(g.light.vertices[j] - g.shading.position - pv.lift[j] * nh), e);
+    out[j] = orient * kahan_cross(Vec3<T>(g.light.vertices[j] - g.shading.position - pv.lift[j] * nh), edge[j]);
   }
   for (int j = 0, prev = last; j < n && last >= 0; ++j) {
     if (has_direction[j])

@@ -209,20 +209,16 @@ template <class T> std::vector<PolygonLightGeometry<T>> unprepared(std::vector<P
 template <template <class> class K, class T> void register_kernel() {
   using G = typename K<T>::Geometry;
   using Light = typename SceneLight<G>::type;
+  const auto to_geometry = [](const Light& light) { return from_light(light, static_cast<const G*>(nullptr)); };
   for (const Scene<Light>& scene : scenes(static_cast<const Light*>(nullptr))) {
     if (kernel_takes_only_rectangles<K<T>>() && scene.vertices != 4) continue;
     for (int spl : {1, kManySamples})
-      benchmark::RegisterBenchmark(
-          name<T>(K<T>::name, scene, spl).c_str(), [spl, l = scene.lights](benchmark::State& s) {
-            run<K, T>(
-                s, l, [](const Light& light) { return from_light(light, static_cast<const G*>(nullptr)); }, spl);
-          });
+      benchmark::RegisterBenchmark(name<T>(K<T>::name, scene, spl).c_str(),
+                                   [=, l = scene.lights](benchmark::State& s) { run<K, T>(s, l, to_geometry, spl); });
     if constexpr (std::is_same_v<Light, PolygonLightGeometry<T>>)
       benchmark::RegisterBenchmark(
-          (name<T>(K<T>::name, scene, 1) + "/unprepared").c_str(), [l = unprepared(scene.lights)](benchmark::State& s) {
-            run<K, T>(
-                s, l, [](const Light& light) { return from_light(light, static_cast<const G*>(nullptr)); }, 1);
-          });
+          (name<T>(K<T>::name, scene, 1) + "/unprepared").c_str(),
+          [=, l = unprepared(scene.lights)](benchmark::State& s) { run<K, T>(s, l, to_geometry, 1); });
   }
 }
 
