@@ -13,33 +13,23 @@
 
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
-#include <fstream>
 #include <functional>
 #include <iostream>
 #include <limits>
 #include <map>
 #include <numbers>
 #include <optional>
-#include <sstream>
 
 #include "warpcheck/catalogue.h"
 #include "warpcheck/validation/searches.h"
+#include "worst_case_fixtures.h"
 
 using namespace warpcheck;
 using namespace warpcheck::validation;
-namespace fs = std::filesystem;
 
 namespace {
 
 using L = long double;
-
-SearchRecord read_record(const std::string& search) {
-  std::ifstream f(fs::path(WARPCHECK_SOURCE_DIR) / "data" / "worst-cases" / (search + ".json"));
-  std::ostringstream text;
-  text << f.rdbuf();
-  return record_from_json(text.str());
-}
 
 // ---- polygon-backward-k*: Peters 2021 Sec. 3.6's backward error, through a polygon ----------------------------
 
@@ -174,9 +164,8 @@ const char* const kProductionReplayNotWritten[] = {"sptd-cap-invariance"};
 // production entry point already, or listed as not written yet (a new step search must choose).
 TEST(RecordedWorstCasesThroughTheKernels, HaveTheRecordedErrorThroughTheKernelsSamplingCode) {
   int replayed = 0;
-  for (const auto& entry : fs::directory_iterator(fs::path(WARPCHECK_SOURCE_DIR) / "data" / "worst-cases")) {
-    if (entry.path().extension() != ".json") continue;
-    const SearchRecord r = read_record(entry.path().stem().string());
+  for (const std::string& name : recorded_worst_case_files()) {
+    const SearchRecord r = read_recorded_worst_case(name);
     SCOPED_TRACE(r.search);
     if (const auto replay = production_replay(r.search)) {
       replayed += (*replay)(r);
@@ -193,7 +182,7 @@ TEST(RecordedWorstCasesThroughTheKernels, HaveTheRecordedErrorThroughTheKernelsS
 // The replay sees a production change the search's own step does not: the kernel sampled with one iteration more
 // than the record's (as if its count had changed) misses the recorded error by orders of magnitude.
 TEST(RecordedWorstCasesThroughTheKernels, APolygonSamplerWithAnotherIterationCountMissesTheRecordedError) {
-  const SearchRecord r = read_record("polygon-backward-k2");
+  const SearchRecord r = read_recorded_worst_case("polygon-backward-k2.json");
   const std::optional<L> three = polygon_backward_error(r.best_x, 3);
   ASSERT_TRUE(three);
   EXPECT_LT(*three, r.best_f / 1000);

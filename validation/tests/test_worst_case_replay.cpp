@@ -8,30 +8,14 @@
 
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
-#include <fstream>
 #include <iostream>
-#include <sstream>
 
-#include "warpcheck/validation/searches.h"
+#include "worst_case_fixtures.h"
 
 using namespace warpcheck::validation;
-namespace fs = std::filesystem;
-
-namespace {
-std::vector<std::string> recorded_files() {
-  std::vector<std::string> v;
-  const fs::path dir = fs::path(WARPCHECK_SOURCE_DIR) / "data" / "worst-cases";
-  if (fs::exists(dir))
-    for (const auto& e : fs::directory_iterator(dir))
-      if (e.path().extension() == ".json") v.push_back(e.path().filename().string());
-  std::sort(v.begin(), v.end());
-  return v;
-}
-}  // namespace
 
 TEST(RecordedWorstCases, ExistForThePolygonSearchAndTheQuintic) {
-  const auto files = recorded_files();
+  const auto files = recorded_worst_case_files();
   for (const char* f : {"polygon-backward-k2.json", "projected-cap-quintic.json"})
     EXPECT_NE(std::find(files.begin(), files.end(), f), files.end()) << f;
 }
@@ -41,16 +25,12 @@ TEST(RecordedWorstCases, ExistForThePolygonSearchAndTheQuintic) {
 constexpr long double kReplaySlack = 1e-9L;
 
 TEST(RecordedWorstCases, AreNoWorseWithTheCurrentKernels) {
-  const auto files = recorded_files();
+  const auto files = recorded_worst_case_files();
   ASSERT_FALSE(files.empty());
   for (const std::string& name : files) {
     SCOPED_TRACE(name);
-    const fs::path p = fs::path(WARPCHECK_SOURCE_DIR) / "data" / "worst-cases" / name;
-    std::ifstream f(p);
-    std::ostringstream text;
-    text << f.rdbuf();
     SearchRecord r;
-    ASSERT_NO_THROW(r = record_from_json(text.str()));
+    ASSERT_NO_THROW(r = read_recorded_worst_case(name));
     const std::optional<Search> s = find_search(r.search);
     ASSERT_TRUE(s) << "unknown search " << r.search;
     EXPECT_EQ(name, r.search + ".json");
@@ -76,11 +56,7 @@ TEST(RecordedWorstCases, AreNoWorseWithTheCurrentKernels) {
 // The replay can fail: a record whose error is 2e-9 relative below what the current kernel gives at its input (as
 // if the kernel had just become worse there by twice the slack) is caught by the comparison above.
 TEST(RecordedWorstCases, AReplayCatchesAnErrorTwiceTheSlackWorseThanRecorded) {
-  const fs::path p = fs::path(WARPCHECK_SOURCE_DIR) / "data" / "worst-cases" / "projected-cap-quintic.json";
-  std::ifstream f(p);
-  std::ostringstream text;
-  text << f.rdbuf();
-  SearchRecord r = record_from_json(text.str());
+  SearchRecord r = read_recorded_worst_case("projected-cap-quintic.json");
   const Search s = *find_search(r.search);
   const long double now = s.objective(r.best_x);
   EXPECT_EQ(now, r.best_f);  // reproduced bit for bit
