@@ -2,6 +2,7 @@
 #include <boost/json.hpp>
 #include <stdexcept>
 
+#include "json_read.h"
 #include "report.h"
 
 namespace warpcheck::validation::report {
@@ -9,18 +10,11 @@ namespace json = boost::json;
 
 namespace {
 
-[[noreturn]] void bad(const std::string& what) { throw std::runtime_error("sample sets: " + what); }
+constexpr const char* kPrefix = "sample sets: ";
+[[noreturn]] void bad(const std::string& what) { throw std::runtime_error(what); }
 
-double number(const json::value& v, const std::string& where) {
-  if (!v.is_number()) bad(where + " is not a number");
-  return v.to_number<double>();
-}
-
-const json::value& member(const json::object& o, const char* key, const std::string& where) {
-  const json::value* v = o.if_contains(key);
-  if (!v) bad(where + " has no \"" + key + "\"");
-  return *v;
-}
+using json_read::member;
+using json_read::number;
 
 // [x, y] inside the cap, [x, y, 1] outside it, null when the sampler declined.
 std::vector<MappedPoint> mapped_points(const json::value& v, const std::string& where) {
@@ -64,28 +58,38 @@ SampleSetCase sample_set_case(const json::value& v, const SampleSets& s, std::si
 
 }  // namespace
 
+namespace {
+
+SampleSets sample_sets(const json::object& o) {
+  SampleSets s;
+  s.grid_lines = int(member(o, "grid_lines", "the file").as_int64());
+  s.grid_line_samples = int(member(o, "grid_line_samples", "the file").as_int64());
+  if (s.grid_lines < 1 || s.grid_line_samples < 2) bad("grid_lines must be >= 1 and grid_line_samples >= 2");
+  const json::value& blue = member(member(o, "blue_noise", "the file").as_object(), "u", "blue_noise");
+  for (const json::value& p : blue.as_array()) {
+    const json::array& a = p.as_array();
+    if (a.size() != 2) bad("a blue-noise point is not [u0, u1]");
+    s.blue_u.push_back({number(a[0], "blue_noise"), number(a[1], "blue_noise")});
+  }
+  const json::array& cases = member(o, "cases", "the file").as_array();
+  for (std::size_t i = 0; i < cases.size(); ++i) s.cases.push_back(sample_set_case(cases[i], s, i));
+  return s;
+}
+
+}  // namespace
+
+// Every error names the file's kind once: "sample sets: <what>".
 SampleSets parse_sample_sets(const std::string& text) {
   std::error_code ec;
   const json::value v = json::parse(text, ec);
-  if (ec || !v.is_object()) bad("not a JSON object");
-  const json::object& o = v.get_object();
-  SampleSets s;
+  if (ec || !v.is_object()) throw std::runtime_error("sample sets: not a JSON object");
   try {
-    s.grid_lines = int(member(o, "grid_lines", "the file").as_int64());
-    s.grid_line_samples = int(member(o, "grid_line_samples", "the file").as_int64());
-    if (s.grid_lines < 1 || s.grid_line_samples < 2) bad("grid_lines must be >= 1 and grid_line_samples >= 2");
-    const json::value& blue = member(member(o, "blue_noise", "the file").as_object(), "u", "blue_noise");
-    for (const json::value& p : blue.as_array()) {
-      const json::array& a = p.as_array();
-      if (a.size() != 2) bad("a blue-noise point is not [u0, u1]");
-      s.blue_u.push_back({number(a[0], "blue_noise"), number(a[1], "blue_noise")});
-    }
-    const json::array& cases = member(o, "cases", "the file").as_array();
-    for (std::size_t i = 0; i < cases.size(); ++i) s.cases.push_back(sample_set_case(cases[i], s, i));
-  } catch (const boost::system::system_error& e) {
-    bad(std::string("a member has the wrong type (") + e.what() + ")");
+    return sample_sets(v.get_object());
+  } catch (const boost::system::system_error& e) {  // a Boost.JSON accessor (as_array, ...) on the wrong type
+    throw std::runtime_error(std::string("sample sets: a member has the wrong type (") + e.what() + ")");
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error(std::string("sample sets: ") + e.what());
   }
-  return s;
 }
 
 }  // namespace warpcheck::validation::report

@@ -10,6 +10,7 @@
 #include <set>
 #include <sstream>
 
+#include "json_read.h"
 #include "report.h"
 
 namespace warpcheck::validation::report {
@@ -618,31 +619,7 @@ std::string bench_section(const fs::path& data) {
 // ---- maps over geometry: data/polygon/geometry-map.json and data/projected-cap/geometry-map.json, measured by
 // build/geometry_maps (validation/tools/geometry_maps.cpp); drawn here, never computed.
 
-const json::value& member(const json::object& o, const char* key) {
-  const json::value* v = o.if_contains(key);
-  if (!v) throw std::runtime_error(std::string("no member \"") + key + "\"");
-  return *v;
-}
-
-double number_of(const json::value& v, const std::string& what) {
-  double x;
-  if (!as_number(v, x)) throw std::runtime_error(what + " is not a number");
-  return x;
-}
-
-// A JSON array of numbers; null reads as NaN (no value there).
-std::vector<double> numbers_of(const json::value& v, const std::string& what) {
-  if (!v.is_array()) throw std::runtime_error(what + " is not an array");
-  std::vector<double> out;
-  for (const json::value& x : v.get_array())
-    out.push_back(x.is_null() ? std::numeric_limits<double>::quiet_NaN() : number_of(x, what + " entry"));
-  return out;
-}
-
-std::string string_of(const json::value& v, const std::string& what) {
-  if (!v.is_string()) throw std::runtime_error(what + " is not a string");
-  return std::string(v.get_string());
-}
+const json::value& member(const json::object& o, const char* key) { return json_read::member(o, key, "the map"); }
 
 std::string rgb(const Rgb& c) {
   return "rgb(" + std::to_string(int(c[0])) + "," + std::to_string(int(c[1])) + "," + std::to_string(int(c[2])) + ")";
@@ -683,11 +660,11 @@ std::string svg_frame_end(const std::string& xlabel, const std::string& ylabel, 
 // count: each case placed by its sector's opening angle and the target's position xi within the sector, coloured
 // by log10 of its backward error.
 std::string polygon_backward_error_maps(const json::object& m) {
-  const std::vector<double> angle = numbers_of(member(m, "opening_angle_degrees"), "opening_angle_degrees"),
-                            xi = numbers_of(member(m, "xi"), "xi");
-  const std::string scalar = string_of(member(m, "scalar"), "scalar");
-  const long long cases = (long long)number_of(member(m, "cases"), "cases"),
-                  seed = (long long)number_of(member(m, "seed"), "seed");
+  const std::vector<double> angle = json_read::numbers(member(m, "opening_angle_degrees"), "opening_angle_degrees"),
+                            xi = json_read::numbers(member(m, "xi"), "xi");
+  const std::string scalar = json_read::string_of(member(m, "scalar"), "scalar");
+  const long long cases = (long long)json_read::number(member(m, "cases"), "cases"),
+                  seed = (long long)json_read::number(member(m, "seed"), "seed");
   const json::value& errors = member(m, "backward_error");
   if (!errors.is_array()) throw std::runtime_error("backward_error is not an array");
   const double lo = -17, hi = 0;  // log10 colour range: double's rounding up to a whole-sector error
@@ -695,8 +672,8 @@ std::string polygon_backward_error_maps(const json::object& m) {
   std::string out;
   for (const json::value& e : errors.get_array()) {
     if (!e.is_object()) throw std::runtime_error("backward_error entry is not an object");
-    const long long iterations = (long long)number_of(member(e.get_object(), "iterations"), "iterations");
-    const std::vector<double> err = numbers_of(member(e.get_object(), "values"), "backward_error values");
+    const long long iterations = (long long)json_read::number(member(e.get_object(), "iterations"), "iterations");
+    const std::vector<double> err = json_read::numbers(member(e.get_object(), "values"), "backward_error values");
     if (angle.size() != std::size_t(cases) || xi.size() != angle.size() || err.size() != angle.size())
       throw std::runtime_error("opening_angle_degrees, xi and values do not all hold one entry per case");
     std::ostringstream o;
@@ -727,9 +704,10 @@ std::string polygon_backward_error_maps(const json::object& m) {
 // 1: Case 4); cells that are not Case 3 are null. Colour: log2 of the ratio over [0, 1] (ratio 1 to 2), the
 // bound's range for d >= 1.094 r; the caption gives the largest ratio / the paper's bound, which must stay <= 1.
 std::string case3_ratio_map(const json::object& m) {
-  const long long nx = (long long)number_of(member(m, "nx"), "nx"), ny = (long long)number_of(member(m, "ny"), "ny");
-  const std::vector<double> xr = numbers_of(member(m, "log10_distance_range"), "log10_distance_range"),
-                            yr = numbers_of(member(m, "depth_range"), "depth_range");
+  const long long nx = (long long)json_read::number(member(m, "nx"), "nx"),
+                  ny = (long long)json_read::number(member(m, "ny"), "ny");
+  const std::vector<double> xr = json_read::numbers(member(m, "log10_distance_range"), "log10_distance_range"),
+                            yr = json_read::numbers(member(m, "depth_range"), "depth_range");
   const json::value &ratios = member(m, "ratio"), &bounds = member(m, "bound");
   if (nx < 1 || ny < 1 || xr.size() != 2 || yr.size() != 2 || !ratios.is_array() || !bounds.is_array() ||
       ratios.get_array().size() != std::size_t(nx) || bounds.get_array().size() != std::size_t(nx))
@@ -738,8 +716,8 @@ std::string case3_ratio_map(const json::object& m) {
   std::ostringstream dots;
   double worst_over_bound = 0, lo_ratio = 1e300, hi_ratio = 0;
   for (long long i = 0; i < nx; ++i) {
-    const std::vector<double> ratio = numbers_of(ratios.get_array()[i], "ratio row"),
-                              bound = numbers_of(bounds.get_array()[i], "bound row");
+    const std::vector<double> ratio = json_read::numbers(ratios.get_array()[i], "ratio row"),
+                              bound = json_read::numbers(bounds.get_array()[i], "bound row");
     if (ratio.size() != std::size_t(ny) || bound.size() != std::size_t(ny))
       throw std::runtime_error("a ratio or bound row does not hold ny entries");
     for (long long j = 0; j < ny; ++j) {
@@ -751,10 +729,10 @@ std::string case3_ratio_map(const json::object& m) {
     }
   }
   std::ostringstream o;
-  o << svg_frame_start("Case-3 density ratio over geometry", "Case-3 density ratio max/min of Alg. 4 (" +
-                                                                 html_escape(string_of(member(m, "scalar"), "scalar")) +
-                                                                 "), " + std::to_string(nx) + " x " +
-                                                                 std::to_string(ny) + " geometries")
+  o << svg_frame_start("Case-3 density ratio over geometry",
+                       "Case-3 density ratio max/min of Alg. 4 (" +
+                           html_escape(json_read::string_of(member(m, "scalar"), "scalar")) + "), " +
+                           std::to_string(nx) + " x " + std::to_string(ny) + " geometries")
     << dots.str();
   for (int k = int(std::floor(xr[0])); k <= int(std::floor(xr[1])); ++k)
     o << "<text x=\"" << L + (R - L) * (k - xr[0]) / (xr[1] - xr[0]) << "\" y=\"" << B + 13
