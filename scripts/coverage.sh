@@ -25,8 +25,10 @@ while [ $# -gt 0 ]; do
 done
 command -v gcovr >/dev/null || { echo "[coverage] installing gcovr"; apt-get install -y -q gcovr >/dev/null; }
 
+LAUNCHER=""
+command -v ccache >/dev/null && LAUNCHER=-DCMAKE_CXX_COMPILER_LAUNCHER=ccache
 cmake -S "$ROOT" -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=None -DCMAKE_CXX_FLAGS="-O1 -g --coverage -fprofile-update=atomic" \
-  -DCMAKE_EXE_LINKER_FLAGS=--coverage -DWARPCHECK_WARNINGS_AS_ERRORS=OFF -DCMAKE_CXX_COMPILER_LAUNCHER=ccache >/dev/null
+  -DCMAKE_EXE_LINKER_FLAGS=--coverage -DWARPCHECK_WARNINGS_AS_ERRORS=OFF $LAUNCHER >/dev/null
 ninja -C "$BUILD" -j"${JOBS:-2}" warpcheck warpcheck_tests warpcheck_fuzz_replay warpcheck_fuzz_tests
 mkdir -p "$OUT"
 
