@@ -577,6 +577,75 @@ std::string fuzz_section(const fs::path& data) {
   return o.str();
 }
 
+// ---- coverage of lib/: data/coverage/summary.json, written by scripts/coverage.sh (coverage_summary.py) --------
+
+std::string coverage_cells(const json::object& run) {
+  std::string out;
+  for (const char* kind : {"lines", "branches"}) {
+    const std::vector<double> c = json_read::numbers(json_read::member(run, kind, "a run"), kind);
+    if (c.size() != 2) throw std::runtime_error(std::string(kind) + " is not [reached, total]");
+    out += "<td>" + (c[1] > 0 ? num(100 * c[0] / c[1], 3) + " % (" + num(c[0], 6) + "/" + num(c[1], 6) + ")" : "-") +
+           "</td>";
+  }
+  return out;
+}
+
+std::string coverage_header_row(const std::string& what, const json::object& h) {
+  return "<tr><td>" + what + "</td>" + coverage_cells(json_read::member(h, "tests", what).as_object()) +
+         coverage_cells(json_read::member(h, "battery", what).as_object()) + "</tr>";
+}
+
+// The sampling-path lines with a branch the battery never takes, each with its reason; a line without one is
+// marked as a failure is.
+std::string coverage_untaken(const json::array& untaken) {
+  std::ostringstream o;
+  std::size_t unexplained = 0;
+  for (const json::value& v : untaken) unexplained += v.as_object().at("reason").is_null();
+  o << "<p>" << untaken.size() << " lines of lib/'s sample and pdf functions hold a branch that the battery never "
+    << "takes; " << unexplained << " of them have no reason in <code>data/coverage/untaken-reasons.tsv</code>.</p>"
+    << "<details><summary>the lines and why</summary><table><tr><th>where</th><th>code</th><th>branches "
+       "untaken</th><th>tests take them</th><th>why the battery does not</th></tr>";
+  for (const json::value& v : untaken) {
+    const json::object& u = v.as_object();
+    const bool why = !u.at("reason").is_null();
+    o << "<tr><td>" << html_escape(json_read::string_of(u.at("file"), "file")) << ":"
+      << num(json_read::number(u.at("line"), "line"), 6) << "</td><td><code>"
+      << html_escape(json_read::string_of(u.at("code"), "code")) << "</code></td><td>"
+      << num(json_read::number(u.at("branches_untaken"), "branches_untaken"), 6) << " of "
+      << num(json_read::number(u.at("branches"), "branches"), 6) << "</td><td>"
+      << (u.at("tests_take_them").as_bool() ? "yes" : "no") << "</td><td" << (why ? ">" : " class=\"fail\">")
+      << html_escape(why ? json_read::string_of(u.at("reason"), "reason") : "not explained") << "</td></tr>";
+  }
+  o << "</table></details>\n";
+  return o.str();
+}
+
+std::string coverage_section(const fs::path& data) {
+  std::ostringstream o;
+  o << "<h2 id=\"coverage\">Coverage of lib/</h2>\n";
+  const fs::path p = data / "coverage" / "summary.json";
+  if (!fs::exists(p)) return o.str() + not_run("data/coverage/summary.json does not exist", "scripts/coverage.sh");
+  try {
+    std::string err;
+    const auto v = load_json(p, err);
+    if (!v || !v->is_object()) throw std::runtime_error(err.empty() ? "not a JSON object" : err);
+    const json::object& c = v->get_object();
+    o << "<p class=\"muted\">Lines and branches of lib/ reached by the default tests and by the battery ("
+      << html_escape(json_read::string_of(json_read::member(c, "battery_run", "the file"), "battery_run"))
+      << "), measured at commit <code>" << html_escape(json_read::string_of(c.at("commit"), "commit"))
+      << "</code> by <code>scripts/coverage.sh</code> (gcc --coverage, gcovr).</p>\n"
+      << "<table><tr><th>header</th><th>lines, tests</th><th>branches, tests</th><th>lines, battery</th>"
+         "<th>branches, battery</th></tr>";
+    for (const json::value& h : json_read::member(c, "headers", "the file").as_array())
+      o << coverage_header_row(html_escape(json_read::string_of(h.as_object().at("file"), "file")), h.as_object());
+    o << coverage_header_row("all of lib/", json_read::member(c, "total", "the file").as_object()) << "</table>\n"
+      << coverage_untaken(json_read::member(c, "untaken", "the file").as_array());
+  } catch (const std::exception& e) {  // std::runtime_error of json_read, boost::system::system_error of as_*
+    return o.str() + "<p class=\"notrun\">data/coverage/summary.json: " + html_escape(e.what()) + "</p>\n";
+  }
+  return o.str();
+}
+
 std::string bench_section(const fs::path& data) {
   std::ostringstream o;
   o << "<h2 id=\"bench\">Benchmarks</h2>\n";
@@ -961,16 +1030,16 @@ void write_index(const BatteryRun& run, const ReportOptions& opt, const Grouped&
   x << page_start("warpcheck report") << "<h1>warpcheck validation report</h1>\n" << run_summary(run, opt, sum);
   x << "<p><a href=\"#matrix\">matrix</a> | <a href=\"#claims\">paper vs ours</a> | <a href=\"#worst\">worst cases</a>"
        " | <a href=\"#fuzz\">fuzz</a> | <a href=\"#bench\">benchmarks</a> | <a href=\"#geometry-maps\">maps over "
-       "geometry</a></p>\n"
+       "geometry</a> | <a href=\"#coverage\">coverage</a></p>\n"
     << matrix(g, run);
   if (opt.data_dir.empty()) {
     x << "<h2 id=\"claims\">Data</h2>" << not_run("no data directory given", "warpcheck report --data data ...")
       << "<span id=\"worst\"></span><span id=\"fuzz\"></span><span id=\"bench\"></span><span "
-         "id=\"geometry-maps\"></span>";
+         "id=\"geometry-maps\"></span><span id=\"coverage\"></span>";
   } else {
     const fs::path data(opt.data_dir);
     x << claims_section(data) << worst_case_section(data) << fuzz_section(data) << bench_section(data)
-      << geometry_maps_section(data);
+      << geometry_maps_section(data) << coverage_section(data);
   }
   x << page_end();
   write_text(fs::path(opt.out_dir) / "index.html", x.str());

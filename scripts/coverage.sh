@@ -5,7 +5,9 @@
 #   battery  warpcheck validate on every named configuration and RANDOM random geometries per family, at
 #            SAMPLES samples per case (default 10^4: which paths a case takes, not whether it passes).
 # Writes coverage/{tests,battery}.json (gcovr's JSON), coverage/summary.md (the table per kernel header for the
-# README) and coverage/untaken.md (the branches of lib/'s sample and pdf functions that the battery never takes).
+# README) and coverage/untaken.md (the branches of lib/'s sample and pdf functions that the battery never takes, each
+# with its reason from data/coverage/untaken-reasons.tsv), and both to data/coverage/summary.json, which the HTML
+# report shows (commit it with the measured commit's figures).
 # Usage: scripts/coverage.sh [--random N] [--samples N]; BUILD_DIR (default build-coverage). Takes long: a
 # separate unoptimised-ish build (-O1) of the tests and the CLI, then both runs under gcov's counters. The counters
 # are updated atomically: the battery's threads otherwise race on them, and gcov then reports negative counts that
@@ -51,7 +53,10 @@ echo "[coverage] battery: named configurations and --random $RANDOM_N at $SAMPLE
   >"$OUT/battery.log" 2>&1 || true
 collect battery
 
+COMMIT="$(git -C "$ROOT" rev-parse --short=8 HEAD)$(git -C "$ROOT" diff --quiet HEAD -- lib || echo ' with changes to lib/')"
+mkdir -p "$ROOT/data/coverage"
 python3 "$ROOT/scripts/coverage_summary.py" "$OUT/tests.json" "$OUT/battery.json" "$OUT/summary.md" "$OUT/untaken.md" \
-  "random $RANDOM_N, $SAMPLES samples"
+  "random $RANDOM_N, $SAMPLES samples" --root "$ROOT" --reasons "$ROOT/data/coverage/untaken-reasons.tsv" \
+  --json "$ROOT/data/coverage/summary.json" --commit "$COMMIT"
 cat "$OUT/summary.md"
 echo "[coverage] untaken sampling-path branches: $OUT/untaken.md"

@@ -382,6 +382,56 @@ TEST(Report, MissingOrMalformedGeometryMapIsReportedNotComputed) {
   EXPECT_EQ(index.find("<svg"), std::string::npos);
 }
 
+// A coverage summary as scripts/coverage.sh writes it (coverage_summary.py): one header, two untaken lines, the
+// second without a reason.
+constexpr const char* kCoverageSummary =
+    R"({"commit":"abcd1234","battery_run":"random 16, 10000 samples","headers":[{"file":"lib/warpcheck/sphere.h",)"
+    R"("tests":{"lines":[98,98],"branches":[165,173]},"battery":{"lines":[90,98],"branches":[119,188]}}],)"
+    R"("total":{"tests":{"lines":[98,98],"branches":[165,173]},"battery":{"lines":[90,98],"branches":[119,188]}},)"
+    R"("untaken":[{"file":"lib/warpcheck/sphere.h","line":90,"function":"sample_sphere_solid_angle<float>",)"
+    R"("code":"if (!v.valid()) return none;","branches_untaken":1,"branches":2,"line_reached":true,)"
+    R"("tests_take_them":true,"reason":"invalid input: a view of an invalid light."},)"
+    R"({"file":"lib/warpcheck/sphere.h","line":120,"function":"pdf_sphere_visible_area<double>",)"
+    R"("code":"return x < y ? a : b;","branches_untaken":2,"branches":4,"line_reached":true,)"
+    R"("tests_take_them":false,"reason":null}]})";
+
+TEST(Report, CoverageFiguresAndEveryUntakenSamplingBranchWithItsReasonAreShown) {
+  const fs::path dir = work_dir();
+  fs::remove_all(dir);
+  fs::create_directories(dir / "data" / "coverage");
+  std::ofstream(dir / "data" / "coverage" / "summary.json") << kCoverageSummary;
+  const std::string index = index_with_data(dir, dir / "data");
+  const auto section = index.find("<h2 id=\"coverage\">");
+  ASSERT_NE(section, std::string::npos);
+  EXPECT_NE(index.find("measured at commit <code>abcd1234</code>", section), std::string::npos);
+  EXPECT_NE(index.find("<tr><td>lib/warpcheck/sphere.h</td><td>100 % (98/98)</td><td>95.4 % (165/173)</td>"
+                       "<td>91.8 % (90/98)</td><td>63.3 % (119/188)</td></tr>",
+                       section),
+            std::string::npos);
+  EXPECT_NE(index.find("2 lines of lib/'s sample and pdf functions hold a branch that the battery never takes; 1 of "
+                       "them have no reason",
+                       section),
+            std::string::npos);
+  EXPECT_NE(index.find("<td>invalid input: a view of an invalid light.</td>", section), std::string::npos);
+  EXPECT_NE(index.find("<code>return x &lt; y ? a : b;</code></td><td>2 of 4</td><td>no</td><td class=\"fail\">not "
+                       "explained</td>",
+                       section),
+            std::string::npos);
+}
+
+TEST(Report, AMissingOrMalformedCoverageSummaryIsReportedWithTheCommandThatWritesIt) {
+  const fs::path dir = work_dir();
+  fs::remove_all(dir);
+  fs::create_directories(dir / "data");
+  EXPECT_NE(index_with_data(dir, dir / "data")
+                .find("Not run: data/coverage/summary.json does not exist. Produce it with <code>scripts/coverage.sh"),
+            std::string::npos);
+  fs::create_directories(dir / "data" / "coverage");
+  std::ofstream(dir / "data" / "coverage" / "summary.json") << R"({"commit":"x","battery_run":"y","headers":[]})";
+  EXPECT_NE(index_with_data(dir, dir / "data").find("data/coverage/summary.json: the file has no &quot;total&quot;"),
+            std::string::npos);
+}
+
 TEST(Report, ResidualMapExrHoldsTheSignedResidualOfEveryBin) {
   const Fixture& f = fixture();
   const BatteryRun run = parse_battery_json(slurp(f.results));
