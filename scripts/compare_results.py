@@ -1,0 +1,110 @@
+#!/usr/bin/env python3
+"""Compares two `warpcheck validate --json` files result by result.
+
+A result is keyed by (kernel, scalar, config, test). Two results agree when their statistic and p-value are the same
+doubles, their verdicts are the same and their detail texts are the same after --replace. Only the cases both files
+hold are compared (a killed run keeps the cases it finished); the others are counted. A statistical test's verdict
+is compared only when both files hold the same cases, since the correction for multiple tests spans the file. Exit status: 0 when every
+compared result agrees, 1 when any differs, 2 on bad input.
+
+  scripts/compare_results.py BEFORE.json AFTER.json [--replace OLD=NEW]... [--show N]
+  scripts/compare_results.py --strip IN.json OUT.json   # drops the residual maps (what --resume does not need)
+"""
+import argparse
+import json
+import sys
+
+
+def load(path):
+    try:
+        with open(path) as f:
+            doc = json.load(f)
+    except (OSError, ValueError) as e:
+        sys.exit(f"compare_results: cannot read '{path}': {e}")
+    if not isinstance(doc, dict) or not isinstance(doc.get("results"), list):
+        sys.exit(f"compare_results: '{path}' is not a warpcheck validate --json file (no \"results\" list)")
+    return doc
+
+
+def by_key(doc):
+    out = {}
+    for r in doc["results"]:
+        out[(r["kernel"], r["scalar"], r["config"], r["test"])] = r
+    return out
+
+
+def differences(a, b, replacements, verdicts):
+    """The fields in which two results with the same key disagree; statistical verdicts only when `verdicts`."""
+    out = []
+    for field in ("statistic", "p_value"):
+        if a.get(field) != b.get(field):  # the same double: both files print it to round trip
+            out.append(f"{field} {a.get(field)!r} -> {b.get(field)!r}")
+    if (verdicts or a.get("p_value") is None) and a.get("passed") != b.get("passed"):
+        out.append(f"passed {a.get('passed')} -> {b.get('passed')}")
+    detail_a = a.get("detail", "")
+    for old, new in replacements:
+        detail_a = detail_a.replace(old, new)
+    if detail_a != b.get("detail", ""):
+        out.append(f"detail {a.get('detail', '')!r} -> {b.get('detail', '')!r}")
+    return out
+
+
+def strip(src, dst):
+    doc = load(src)
+    for r in doc["results"]:
+        r.pop("map", None)
+    with open(dst, "w") as f:
+        json.dump(doc, f, separators=(",", ":"))
+        f.write("\n")
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("before")
+    p.add_argument("after")
+    p.add_argument("--replace", action="append", default=[], metavar="OLD=NEW",
+                   help="text replaced in BEFORE's detail before comparing (a renamed file, say)")
+    p.add_argument("--show", type=int, default=20, help="differences printed (default 20)")
+    p.add_argument("--strip", action="store_true", help="write BEFORE without its maps to the file AFTER")
+    a = p.parse_args()
+    if a.strip:
+        strip(a.before, a.after)
+        return 0
+    replacements = []
+    for r in a.replace:
+        if "=" not in r:
+            sys.exit(f"compare_results: --replace takes OLD=NEW, not '{r}'")
+        replacements.append(tuple(r.split("=", 1)))
+
+    before, after = by_key(load(a.before)), by_key(load(a.after))
+    case = lambda k: k[:3]
+    cases_before, cases_after = {case(k) for k in before}, {case(k) for k in after}
+    common = cases_before & cases_after
+    # A statistical test's verdict is corrected (Holm, Sidak) over all of its file's tests: compared only when both
+    # files hold the same cases.
+    verdicts = cases_before == cases_after
+    compared = differing = 0
+    only = {"before": [], "after": []}
+    for key in sorted(set(before) | set(after)):
+        if case(key) not in common:
+            continue
+        if key not in after or key not in before:
+            only["before" if key in before else "after"].append(key)
+            continue
+        compared += 1
+        d = differences(before[key], after[key], replacements, verdicts)
+        if d:
+            differing += 1
+            if differing <= a.show:
+                print(" ".join(key) + ": " + "; ".join(d))
+    print(f"cases: {len(cases_before)} before, {len(cases_after)} after, {len(common)} in both")
+    print(f"results compared: {compared}, differing: {differing}" +
+          ("" if verdicts else " (statistical verdicts not compared: the files hold different cases)"))
+    for side, keys in only.items():
+        if keys:
+            print(f"tests only {side} in common cases: {len(keys)} (e.g. {' '.join(keys[0])})")
+    return 1 if differing or any(only.values()) else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
