@@ -2,8 +2,8 @@
 # Line and branch coverage of lib/ (gcc --coverage, gcovr), measured twice:
 #   tests    the default test run (ctest -L fast) with battery.every_case at 10^4 samples instead of 10^6
 #            (coverage needs no statistics; the cases are the same);
-#   battery  warpcheck validate on every named configuration and RANDOM random geometries per family, at
-#            SAMPLES samples per case (default 10^4: which paths a case takes, not whether it passes).
+#   battery  warpcheck validate on every named configuration and RANDOM random geometries per family (default 4,
+#            as scripts/battery.sh runs the battery), at SAMPLES samples per case (default 10^4: which paths a case takes, not whether it passes).
 # Writes coverage/{tests,battery}.json (gcovr's JSON), coverage/summary.md (the table per kernel header for the
 # README) and coverage/untaken.md (the branches of lib/'s sample and pdf functions that the battery never takes, each
 # with its reason from data/coverage/untaken-reasons.tsv), and both to data/coverage/summary.json, which the HTML
@@ -16,7 +16,7 @@ set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD="${BUILD_DIR:-$ROOT/build-coverage}"
 OUT="$ROOT/coverage"
-RANDOM_N=16
+RANDOM_N=4  # as scripts/battery.sh runs the battery
 SAMPLES=10000
 while [ $# -gt 0 ]; do
   case "$1" in
