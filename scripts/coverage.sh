@@ -3,7 +3,8 @@
 #   tests    the default test run (ctest -L fast) with battery.every_case at 10^4 samples instead of 10^6
 #            (coverage needs no statistics; the cases are the same);
 #   battery  warpcheck validate on every named configuration and RANDOM random geometries per family (default 4,
-#            as scripts/battery.sh runs the battery), at SAMPLES samples per case (default 10^4: which paths a case takes, not whether it passes).
+#            as scripts/battery.sh runs the battery), at SAMPLES samples per case (default 10^4: which paths a case
+#            takes, not whether it passes).
 # Writes coverage/{tests,battery}.json (gcovr's JSON), coverage/summary.md (the table per kernel header for the
 # README) and coverage/untaken.md (the branches of lib/'s sample and pdf functions that the battery never takes, each
 # with its reason from data/coverage/untaken-reasons.tsv), and both to data/coverage/summary.json, which the HTML
