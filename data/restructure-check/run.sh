@@ -27,7 +27,7 @@ build() {  # $1: before or after
 }
 
 # One JSON file per kernel, so that a finished kernel's results are never read back: 2760acf's --resume reads its file
-# with a parser that can change a double's last bit (seen on 39 of 117 results), and rewrites it so.
+# with a parser that can change a double's last bit, and rewrites it so.
 side() {  # $1: before or after; runs every kernel of KERNELS in order, each into its own file
   local k
   [[ -d "$WORK/$1.results" || ! -f "$HERE/$1.json.xz" ]] || split_stored "$1"
