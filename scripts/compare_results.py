@@ -4,15 +4,19 @@
 A result is keyed by (kernel, scalar, config, test). Two results agree when their statistic and p-value are the same
 doubles, their verdicts are the same and their detail texts are the same after --replace. Only the cases both files
 hold are compared (a killed run keeps the cases it finished); the others are counted. A statistical test's verdict
-is compared only when both files hold the same cases, since the correction for multiple tests spans the file. Exit status: 0 when every
-compared result agrees, 1 when any differs, 2 on bad input.
+is compared only when both files hold the same cases, since the correction for multiple tests spans the file.
+Exit status: 0 when every compared result agrees, 1 when any differs, 2 on bad input.
 
   scripts/compare_results.py BEFORE.json AFTER.json [--replace OLD=NEW]... [--show N]
-  scripts/compare_results.py --strip IN.json OUT.json   # drops the residual maps (what --resume does not need)
 """
 import argparse
 import json
 import sys
+
+
+def bad_input(message):
+    print(f"compare_results: {message}", file=sys.stderr)
+    sys.exit(2)
 
 
 def load(path):
@@ -20,9 +24,9 @@ def load(path):
         with open(path) as f:
             doc = json.load(f)
     except (OSError, ValueError) as e:
-        sys.exit(f"compare_results: cannot read '{path}': {e}")
+        bad_input(f"cannot read '{path}': {e}")
     if not isinstance(doc, dict) or not isinstance(doc.get("results"), list):
-        sys.exit(f"compare_results: '{path}' is not a warpcheck validate --json file (no \"results\" list)")
+        bad_input(f"'{path}' is not a warpcheck validate --json file (no \"results\" list)")
     return doc
 
 
@@ -49,15 +53,6 @@ def differences(a, b, replacements, verdicts):
     return out
 
 
-def strip(src, dst):
-    doc = load(src)
-    for r in doc["results"]:
-        r.pop("map", None)
-    with open(dst, "w") as f:
-        json.dump(doc, f, separators=(",", ":"))
-        f.write("\n")
-
-
 def main():
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("before")
@@ -65,15 +60,11 @@ def main():
     p.add_argument("--replace", action="append", default=[], metavar="OLD=NEW",
                    help="text replaced in BEFORE's detail before comparing (a renamed file, say)")
     p.add_argument("--show", type=int, default=20, help="differences printed (default 20)")
-    p.add_argument("--strip", action="store_true", help="write BEFORE without its maps to the file AFTER")
     a = p.parse_args()
-    if a.strip:
-        strip(a.before, a.after)
-        return 0
     replacements = []
     for r in a.replace:
         if "=" not in r:
-            sys.exit(f"compare_results: --replace takes OLD=NEW, not '{r}'")
+            bad_input(f"--replace takes OLD=NEW, not '{r}'")
         replacements.append(tuple(r.split("=", 1)))
 
     before, after = by_key(load(a.before)), by_key(load(a.after))
