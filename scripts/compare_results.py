@@ -1,13 +1,13 @@
 #!/usr/bin/env python3
 """Compares two `warpcheck validate --json` files result by result.
 
-A result is keyed by (kernel, scalar, config, test). Two results agree when their statistic and p-value are the same
+A result is keyed by (kernel, scalar, config, test); --rename gives a case BEFORE's key under AFTER's names. Two results agree when their statistic and p-value are the same
 doubles, their verdicts are the same and their detail texts are the same after --replace. Only the cases both files
 hold are compared (a killed run keeps the cases it finished); the others are counted. A statistical test's verdict
 is compared only when both files hold the same cases, since the correction for multiple tests spans the file.
 Exit status: 0 when every compared result agrees, 1 when any differs, 2 on bad input.
 
-  scripts/compare_results.py BEFORE.json AFTER.json [--replace OLD=NEW]... [--show N]
+  scripts/compare_results.py BEFORE.json AFTER.json [--replace OLD=NEW]... [--rename K/C=K/C]... [--show N]
 """
 import argparse
 import json
@@ -30,10 +30,11 @@ def load(path):
     return doc
 
 
-def by_key(doc):
+def by_key(doc, renames={}):
     out = {}
     for r in doc["results"]:
-        out[(r["kernel"], r["scalar"], r["config"], r["test"])] = r
+        kernel, config = renames.get((r["kernel"], r["config"]), (r["kernel"], r["config"]))
+        out[(kernel, r["scalar"], config, r["test"])] = r
     return out
 
 
@@ -59,6 +60,8 @@ def main():
     p.add_argument("after")
     p.add_argument("--replace", action="append", default=[], metavar="OLD=NEW",
                    help="text replaced in BEFORE's detail before comparing (a renamed file, say)")
+    p.add_argument("--rename", action="append", default=[], metavar="KERNEL/CONFIG=KERNEL/CONFIG",
+                   help="a case of BEFORE compared with the case of AFTER so named (a renamed kernel, say)")
     p.add_argument("--show", type=int, default=20, help="differences printed (default 20)")
     a = p.parse_args()
     replacements = []
@@ -67,7 +70,14 @@ def main():
             bad_input(f"--replace takes OLD=NEW, not '{r}'")
         replacements.append(tuple(r.split("=", 1)))
 
-    before, after = by_key(load(a.before)), by_key(load(a.after))
+    renames = {}
+    for r in a.rename:
+        old, _, new = r.partition("=")
+        if old.count("/") != 1 or new.count("/") != 1:
+            bad_input(f"--rename takes KERNEL/CONFIG=KERNEL/CONFIG, not '{r}'")
+        renames[tuple(old.split("/"))] = tuple(new.split("/"))
+
+    before, after = by_key(load(a.before), renames), by_key(load(a.after))
     case = lambda k: k[:3]
     cases_before, cases_after = {case(k) for k in before}, {case(k) for k in after}
     common = cases_before & cases_after
