@@ -14,7 +14,7 @@ Usage: scripts/mutants.sh [--only GLOB] [--samples N] [--random N] [--keep-going
 Applies each mutant validation/mutants/<family>-<name>.patch (a unified diff against lib/ or validation/battery/,
 its first line "# slip: ..." saying what slip it models) to a scratch copy of HEAD (a git worktree DIR/tree,
 detached, reset before every mutant; the working tree is never touched), builds it in one reused build directory
-DIR/tree/build (ccache), and runs the kill stages in order of cost:
+DIR/tree/build (through ccache when it is installed), and runs the kill stages in order of cost:
 
   1a the fuzz replays of the family's kernels (ctest fuzz_replay.*; one translation unit to build)
   1b the family's fast gtests (warpcheck_tests --gtest_filter: the family's suites and those on every kernel, see
@@ -149,7 +149,9 @@ for m in "${SELECTED[@]}"; do
     die "stale mutant $m: its patch does not apply to HEAD ($HEAD_SHA): $(head -c 400 "$DIR/logs/apply.err")"
 done
 if [ ! -f "$BUILD/build.ninja" ]; then
-  cmake -S "$TREE" -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_COMPILER_LAUNCHER=ccache \
+  LAUNCHER=()
+  command -v ccache >/dev/null && LAUNCHER=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+  cmake -S "$TREE" -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=Release "${LAUNCHER[@]}" \
     -DWARPCHECK_WARNINGS_AS_ERRORS=ON >"$DIR/logs/cmake.log" 2>&1 || { echo "cmake failed: $DIR/logs/cmake.log" >&2; exit 1; }
 fi
 JOBS="${MUTANTS_JOBS:-2}"
