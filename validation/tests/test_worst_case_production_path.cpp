@@ -6,9 +6,7 @@
 // Searches that already measure through the production entry point, K::sample on K::view of the catalogue traits
 // (searches/kernels.cpp), and need no second replay: precision-<kernel>-<float|double>-<angle|backward> and
 // pdf-warp-<kernel>; projected-cap-case3-ratio calls sample_projected_spherical_cap<kExact>, which is
-// sphere-projected-cap-exact's sample. sptd-cap-invariance calls pivot_transform and pivot_transform_cap, which
-// make_sptd_cap_view calls too, but the uniform base's small images take another path (image_offset); its
-// production replay is not written yet.
+// sphere-projected-cap-exact's sample.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -137,6 +135,57 @@ bool replay_projected_cap_quintic(const SearchRecord& r) {
   return true;
 }
 
+// ---- sptd-cap-invariance: Eqs. 6-7's image cap, through the uniform SPTD's sampler -----------------------------
+
+// The search's input (searches/caps.cpp): pivot r_p, cap C of half-angle alpha, and w on C's boundary.
+struct CapInvarianceInput {
+  Vec3<L> pivot, w;
+  Cap<L> cap;
+  L alpha;
+};
+CapInvarianceInput cap_invariance_input(const std::vector<L>& p) {
+  auto dir = [](L polar, L azimuth) {
+    return Vec3<L>(std::sin(polar) * std::cos(azimuth), std::sin(polar) * std::sin(azimuth), std::cos(polar));
+  };
+  const Vec3<L> axis = dir(p[3], p[4]);
+  const L alpha = p[5], half = std::sin(alpha / 2);
+  const Frame<L> f = Frame<L>::from_z(axis);
+  const Vec3<L> w = std::cos(alpha) * axis + std::sin(alpha) * (std::cos(p[6]) * f.x + std::sin(p[6]) * f.y);
+  return {p[0] * dir(p[1], p[2]), w, Cap<L>{axis, 2 * half * half}, alpha};
+}
+
+// The search measures, in the image, the angle by which g(w) misses the boundary of g(C). Through the kernel: the
+// uniform SPTD's sample on the boundary of g(C) (u0 = 1, at the azimuth of g(w) from the kernel's inverse) misses
+// the boundary of C by an angle that g carries to the image with its conformal scale k / |w - r_p|^2 (Eq. 4's
+// Jacobian is its square); u0 below 1 samples inside the boundary. nullopt where the kernel declines the input.
+std::optional<L> sptd_boundary_error_through_the_sampler(const std::vector<L>& p, L u0 = 1) {
+  using K = SptdUniformCap<L>;
+  const CapInvarianceInput in = cap_invariance_input(p);
+  SptdCapGeometry<L> g;
+  g.sptd.pivot = in.pivot, g.sptd.base = SptdBase::kUniform, g.cap = in.cap;
+  const K::View v = K::view(g);
+  Vec2<L> u;
+  if (!v.valid() || !K::invert(v, in.w, u)) return std::nullopt;
+  const DirectionSample<L> s = K::sample(v, Vec2<L>(u0, u[1]));
+  if (!s.valid()) return std::nullopt;
+  const L to_axis = std::atan2(s.direction.cross(in.cap.axis).norm(), s.direction.dot(in.cap.axis));
+  return std::abs(to_axis - in.alpha) * v.k / (in.w - in.pivot).squaredNorm();
+}
+
+// The record's input through the kernel has the search's error at that input (which the replay test holds to the
+// record) to 256 long double epsilons: the sample's own roundings (the image frame, the cap offset at u0 = 1, g and
+// the normalisation; 42 epsilons at the recorded input), the two sharing the rounding of g(C)'s 1 - cos.
+bool replay_sptd_cap_invariance(const SearchRecord& r) {
+  const std::optional<L> now = sptd_boundary_error_through_the_sampler(r.best_x);
+  EXPECT_TRUE(now) << "the uniform SPTD declined the recorded pivot and cap";
+  if (now) {
+    const L search = find_search(r.search)->objective(r.best_x);
+    EXPECT_NEAR(*now, search, 256 * std::numeric_limits<L>::epsilon())
+        << "the search's step " << double(search) << ", through the kernel " << double(*now);
+  }
+  return true;
+}
+
 // How each recorded search is replayed through the kernels: a replay (true when it ran), or none where the search
 // already measures through the production entry point or its replay is not written (file comment).
 std::optional<std::function<bool(const SearchRecord&)>> production_replay(const std::string& search) {
@@ -148,6 +197,7 @@ std::optional<std::function<bool(const SearchRecord&)>> production_replay(const 
   if (const auto it = backward.find(search); it != backward.end())
     return [k = it->second](const SearchRecord& r) { return replay_polygon_backward(r, k); };
   if (search == "projected-cap-quintic") return replay_projected_cap_quintic;
+  if (search == "sptd-cap-invariance") return replay_sptd_cap_invariance;
   return std::nullopt;
 }
 
@@ -155,13 +205,12 @@ bool measured_through_the_production_entry_point(const std::string& search) {
   return search.rfind("precision-", 0) == 0 || search.rfind("pdf-warp-", 0) == 0 ||
          search == "projected-cap-case3-ratio";
 }
-const char* const kProductionReplayNotWritten[] = {"sptd-cap-invariance"};
 
 }  // namespace
 
 // Every recorded worst case of a search that measures one step through its own call of it has the recorded error
-// through the kernel's sampling code too; every recorded search is either replayed so, measured through the
-// production entry point already, or listed as not written yet (a new step search must choose).
+// through the kernel's sampling code too; every recorded search is either replayed so or measured through the
+// production entry point already (a new step search must choose).
 TEST(RecordedWorstCasesThroughTheKernels, HaveTheRecordedErrorThroughTheKernelsSamplingCode) {
   int replayed = 0;
   for (const std::string& name : recorded_worst_case_files()) {
@@ -171,12 +220,10 @@ TEST(RecordedWorstCasesThroughTheKernels, HaveTheRecordedErrorThroughTheKernelsS
       replayed += (*replay)(r);
       continue;
     }
-    const bool listed = std::find(std::begin(kProductionReplayNotWritten), std::end(kProductionReplayNotWritten),
-                                  r.search) != std::end(kProductionReplayNotWritten);
-    EXPECT_TRUE(measured_through_the_production_entry_point(r.search) || listed)
+    EXPECT_TRUE(measured_through_the_production_entry_point(r.search))
         << "a recorded search without a replay through the kernel's sampling code";
   }
-  EXPECT_GE(replayed, 5);  // polygon-backward-k0, k2, k3, k2-area1e-7 and projected-cap-quintic
+  EXPECT_GE(replayed, 6);  // polygon-backward-k0, k2, k3, k2-area1e-7, projected-cap-quintic, sptd-cap-invariance
 }
 
 // The replay sees a production change the search's own step does not: the kernel sampled with one iteration more
@@ -186,4 +233,16 @@ TEST(RecordedWorstCasesThroughTheKernels, APolygonSamplerWithAnotherIterationCou
   const std::optional<L> three = polygon_backward_error(r.best_x, 3);
   ASSERT_TRUE(three);
   EXPECT_LT(*three, r.best_f / 1000);
+}
+
+// The SPTD replay sees a sampler that misses the image's boundary: a sample at u0 = 1 - 1e-9 instead of 1 lands
+// inside C by about 1e-9 of g(C)'s width, carried back by g, orders of magnitude beyond the recorded error.
+TEST(RecordedWorstCasesThroughTheKernels, AnSptdSampleInsideTheImageBoundaryMissesTheRecordedError) {
+  const SearchRecord r = read_recorded_worst_case("sptd-cap-invariance.json");
+  const std::optional<L> on_boundary = sptd_boundary_error_through_the_sampler(r.best_x);
+  ASSERT_TRUE(on_boundary);
+  EXPECT_LE(*on_boundary, r.best_f);
+  const std::optional<L> inside = sptd_boundary_error_through_the_sampler(r.best_x, 1 - 1e-9L);
+  ASSERT_TRUE(inside);
+  EXPECT_GT(*inside, 1000 * r.best_f);
 }
