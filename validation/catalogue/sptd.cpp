@@ -3,6 +3,7 @@
 // cosine's projected cap region, the pivot phase function alone and jointly with a sphere light (configurations
 // of the uniform kernel), and LTC transforms from the identity to near-singular.
 #include <Eigen/SVD>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -43,6 +44,9 @@ std::vector<SptdConfig> sptd_configs() {
   return {
       {"sptd-uniform-cap", "centre", "pivot at the centre (uniform over the cap), cap half-angle 46 deg",
        sptd(Vec3L(0, 0, 0), U, kZ, cap(Vec3L(0.3L, 0, 1), 0.3L))},
+      {"sptd-uniform-cap", "centre-small-cap",
+       "pivot at the centre, cap half-angle 20 deg: an image below 30 deg, sampled relative to the pivot",
+       sptd(Vec3L(0, 0, 0), U, kZ, cap(Vec3L(0.3L, 0, 1), 0.06L))},
       {"sptd-uniform-cap", "pivot-0.3", "|r_p| = 0.3 off the cap's axis, cap half-angle 46 deg",
        sptd(Vec3L(0.2L, 0.1L, 0.2L).normalized() * 0.3L, U, kZ, cap(Vec3L(0.3L, 0, 1), 0.3L))},
       {"sptd-uniform-cap", "pivot-0.99", "|r_p| = 0.99 towards the cap's edge, cap half-angle 37 deg",
@@ -122,6 +126,10 @@ PolygonLightGeometry<Real> decentral_rectangle() {
                                Vec3L(0.2L, 0.2L, 1.2L)};
   return g;
 }
+PolygonLightGeometry<Real> clockwise(PolygonLightGeometry<Real> g) {  // the same light, vertices in the other order
+  std::reverse(g.light.vertices.begin(), g.light.vertices.begin() + g.light.count);
+  return g;
+}
 PolygonLightGeometry<Real> straddling_rectangle() {  // crosses the shading horizon
   PolygonLightGeometry<Real> g;
   g.shading.position = Vec3L(0, 0, 0);
@@ -146,6 +154,9 @@ std::vector<LtcConfig> ltc_configs() {
        "M = I (projected solid angle sampling), decentral rectangle",
        {decentral_rectangle(), Mat3<Real>::Identity()}},
       {"random", "a random LTC-like M (condition number ~3), decentral rectangle", {decentral_rectangle(), random}},
+      {"random-reversed",
+       "the random M, decentral rectangle with its vertices in the other order (Sec. 3.1's flipped y axis)",
+       {clockwise(decentral_rectangle()), random}},
       {"ill-conditioned",
        "narrow lobe tilted towards the light: |M| = 1.2e-5, condition number ~300",
        {decentral_rectangle(), mat(0.004L, 0, 0.5L, 0, 0.003L, -0.1L, 0, 0, 1)}},
