@@ -163,6 +163,15 @@ build() {
   ninja -C "$BUILD" -j "$JOBS" "$@" >>"$log" 2>&1
 }
 ALL_TARGETS=(warpcheck warpcheck_tests warpcheck_fuzz_replay)
+TESTS="$BUILD/validation/warpcheck_tests"
+# A test binary that is not there after its build kills nothing: the stage (run in a subshell) leaves $ABORT, and
+# the run stops with exit 1 instead of counting a kill.
+ABORT="$DIR/abort"
+rm -f "$ABORT"
+run_tests() {
+  [ -x "$TESTS" ] || { echo "$TESTS missing after its build" >"$ABORT"; return 0; }
+  "$TESTS" "$@"
+}
 
 # ---- the stages; each prints what killed the mutant (empty: nothing) ----
 # Runs the family's battery run at N samples (stage 2: 10^6 without random geometries; stage 3: N with them) and
@@ -226,7 +235,7 @@ stage1b() {
   local log="$DIR/logs/$m-s1b.log"
   what="$(build_or_kill "$m" warpcheck_tests)"
   [ -z "$what" ] || { echo "$what"; return; }
-  "$BUILD/warpcheck_tests" --gtest_filter="$(family_suites "$family")" >"$log" 2>&1 ||
+  run_tests --gtest_filter="$(family_suites "$family")" >"$log" 2>&1 ||
     { echo "gtest: $(sed -nE 's/^\[  FAILED  \] ([^ ]+).*/\1/p' "$log" | head -1)"; return; }
 }
 stage2() {
@@ -235,7 +244,7 @@ stage2() {
   local what
   what="$(build_or_kill "$m" warpcheck_tests warpcheck_fuzz_replay)"
   [ -z "$what" ] || { echo "$what"; return; }
-  "$BUILD/warpcheck_tests" >"$log" 2>&1 ||
+  run_tests >"$log" 2>&1 ||
     { echo "gtest: $(sed -nE 's/^\[  FAILED  \] ([^ ]+).*/\1/p' "$log" | head -1)"; return; }
   (cd "$BUILD" && ctest --output-on-failure -R '^fuzz_replay\.' -j "$JOBS" >>"$log" 2>&1) ||
     { echo "$(sed -nE 's/.*- (fuzz_replay\.[^ ]+) \(Failed\).*/\1/p' "$log" | head -1)"; return; }
@@ -271,6 +280,7 @@ for m in "${SELECTED[@]}"; do
     : >"$DIR/logs/$m-build.log"
     for s in $STAGES; do
       what="$(stage$s "$family" "$m")"
+      [ ! -f "$ABORT" ] || { echo "mutants.sh: $(cat "$ABORT")" >&2; exit 1; }
       if [ -n "$what" ]; then
         if [ "$outcome" = killed ]; then
           by="$by; stage $s: $what"
