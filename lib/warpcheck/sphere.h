@@ -123,8 +123,8 @@ DirectionSample<T> sample_sphere_visible_area(const SphereView<T>& v, const Sphe
   sine_cosine(phi, sin_phi, cos_phi);
   const Vec3<T> local(r * sin_a * cos_phi, r * sin_a * sin_phi, d - r * cos_a);
   const T dist = stable_norm(local);
-  // |p - x| beyond T's range (radius ~1e308): the density is not representable either. Tested before local / dist,
-  // whose renormalisation would divide by zero.
+  // |p - x|^2 = r^2 + d^2 - 2 d r cos_a <= d^2 - r^2 on the visible cap, so dist is finite for a valid view; tested
+  // all the same before local / dist, which a non-finite norm would turn into NaN.
   if (!std::isfinite(dist)) return DirectionSample<T>::none(NoSample::kTooSmall);
   // cos_light * dist = -m.(p - x) = d cos_a - r = (d - r)(1 - u0): exact algebra, no cancellation.
   const T cos_light_times_dist = (d - r) * (T(1) - u[0]);
