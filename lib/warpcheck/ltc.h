@@ -44,7 +44,7 @@ template <class T> T ltc_density_local(const Mat3<T>& m_inv, T det_inv, const Ve
 template <class T> struct LtcPolygonView {
   NoSample reason = NoSample::kNone;
   Frame<T> frame = Frame<T>::from_z(Vec3<T>(T(0), T(0), T(1)));  // the shading frame
-  Mat3<T> m = Mat3<T>::Identity(), m_inv = Mat3<T>::Identity();
+  Mat3<T> m = Mat3<T>::Identity(), m_inv = Mat3<T>::Identity();  // M as ltc_unit_scale scales it, and its inverse
   T det = T(1), det_inv = T(1);
   PolygonProjectedView<T> transformed;  // M^-1 P, seen from the origin with normal z, clipped to z >= 0
   // pdf()'s test "w in P", by P's own planes in world space (polygon_inward_planes): equivalent to M^-1 w in the
@@ -84,6 +84,18 @@ template <class T> PolygonLightGeometry<T> ltc_unit_magnitude(PolygonLightGeomet
   return tg;
 }
 
+// M scaled exactly (by a power of two) so that its largest entry lies in [1, 2). p_M does not change under M -> s M
+// (s > 0), and neither do the samples and pdfs, but |M c|^3 and |M^-1| of an M of scale 1e12 in float (1e102 in
+// double, or a smaller anisotropic one) over- or underflow where their product does not. The scaling is exact
+// unless an entry falls below T's normal range relative to the largest; where M's own arithmetic stays in range,
+// the samples and pdfs are bit for bit those of M unscaled.
+template <class T> Mat3<T> ltc_unit_scale(const Mat3<T>& m) {
+  const T magnitude = m.cwiseAbs().maxCoeff();
+  if (!(magnitude > T(0)) || !std::isfinite(magnitude)) return m;
+  const int e = std::ilogb(magnitude);
+  return m.unaryExpr([e](T x) { return scale_by_power_of_two(x, -e); });
+}
+
 // The rounding of M^-1 P's vertices relative to |M^-1 v|_inf (check_polygon's vertex_rounding): the frame change's
 // and the product's, 3 eps |M^-1|_F |v|_2 <= 3 sqrt(3) eps cond_F(M) |M^-1 v|_inf.
 template <class T> T ltc_vertex_rounding(const Mat3<T>& m, const Mat3<T>& m_inv) {
@@ -98,12 +110,12 @@ template <class T> LtcPolygonView<T> make_ltc_polygon_view(const LtcPolygonGeome
   if (!g.m.allFinite()) return v.reason = NoSample::kNonFinite, v;
   v.frame = pv.frame;
   v.planes = polygon_inward_planes(g.polygon, pv, v.inward.data());
-  v.m = g.m;
+  v.m = ltc_unit_scale(g.m);
   // |M| > 0 (Sec. 4.1). A singular or reflecting M has no LTC; an M whose inverse overflows neither.
-  if (!ltc_inverse(g.m, &v.m_inv, &v.det)) return v.reason = NoSample::kInvalidGeometry, v;
+  if (!ltc_inverse(v.m, &v.m_inv, &v.det)) return v.reason = NoSample::kInvalidGeometry, v;
   v.det_inv = T(1) / v.det;
   v.transformed = make_polygon_projected_view(ltc_unit_magnitude(ltc_transformed_polygon(pv, v.m_inv)),
-                                              ltc_vertex_rounding(g.m, v.m_inv));
+                                              ltc_vertex_rounding(v.m, v.m_inv));
   if (!v.transformed.valid()) return v.reason = v.transformed.reason, v;
   v.integral = v.transformed.projected_solid_angle / kPi<T>;
   return v;

@@ -2,6 +2,8 @@
 // of one core, is in slow_ltc.cpp.)
 #include <gtest/gtest.h>
 
+#include <Eigen/QR>
+
 #include <algorithm>
 #include <boost/math/statistics/t_test.hpp>
 #include <cfenv>
@@ -79,32 +81,77 @@ TEST(Ltc, SingularOrReflectingTransformsGiveNoSample) {
             NoSample::kInvalidGeometry);
 }
 
-// The LTC of s M is that of M for every s > 0: scaled by a power of two, M gives the same samples and pdfs bit for
-// bit as long as |M| stays a normal number. At 2^275 (the fitted form at 6e82) M^-1 P lies at 1e-82, where Newell's
-// vector's squared norm underflows (the view refused it as zero-sized); at 2^-300 its coordinates' fourth powers
-// overflow.
-TEST(Ltc, AnMatrixScaledByAPowerOfTwoSamplesAsTheUnscaledOneWhileItsDeterminantIsNormal) {
-  const auto pg = test_polygon().cast<double>();
-  Mat3<double> m;
+// The LTC of s M is that of M for every s > 0, and scaled by a power of two M gives the same samples and pdfs bit for
+// bit (the view scales M to unit size exactly, ltc_unit_scale), also where s M alone would leave T's range: with M
+// as given, float refused 36 of 100 samples at 2^42 (|M c|^3 times the projected density overflowed) and the view
+// at 2^+-43, double the view at 2^+-400 (|s M| = 2^+-1200), and 2^275 put M^-1 P at 1e-82, where Newell's vector's
+// squared norm underflows.
+template <class T> void expect_power_of_two_scales_sample_as_the_unscaled_transform(std::initializer_list<int> es) {
+  const auto pg = test_polygon().cast<T>();
+  Mat3<T> m;
   m << 2, 0, 4, 0, 1, 0, 0.25, 0, 1;
-  const LtcPolygonView<double> v = make_ltc_polygon_view(LtcPolygonGeometry<double>{pg, m});
+  const LtcPolygonView<T> v = make_ltc_polygon_view(LtcPolygonGeometry<T>{pg, m});
   ASSERT_TRUE(v.valid());
   std::mt19937_64 r(5);
   std::uniform_real_distribution<double> u(0, 1);
-  for (const int e : {-300, -200, -100, 100, 200, 275, 300}) {  // |s M| = 2^(3 e) |M|, |M| = 1
-    const LtcPolygonView<double> s =
-        make_ltc_polygon_view(LtcPolygonGeometry<double>{pg, Mat3<double>(m * std::ldexp(1.0, e))});
+  for (const int e : es) {  // |s M| = 2^(3 e) |M|, |M| = 1
+    const LtcPolygonView<T> s = make_ltc_polygon_view(LtcPolygonGeometry<T>{pg, Mat3<T>(m * std::ldexp(T(1), e))});
     ASSERT_TRUE(s.valid()) << "2^" << e << ": " << to_string(s.reason);
     EXPECT_EQ(s.integral, v.integral) << e;
     for (int i = 0; i < 100; ++i) {
-      const Vec2<double> x(u(r), u(r));
-      const DirectionSample<double> a = sample_ltc_polygon(v, x), b = sample_ltc_polygon(s, x);
+      const Vec2<T> x(T(u(r)), T(u(r)));
+      const DirectionSample<T> a = sample_ltc_polygon(v, x), b = sample_ltc_polygon(s, x);
       ASSERT_TRUE(a.valid() && b.valid()) << e;
       EXPECT_EQ(a.direction, b.direction) << e;
       EXPECT_EQ(a.pdf, b.pdf) << e;
       EXPECT_EQ(pdf_ltc_polygon(v, a.direction), pdf_ltc_polygon(s, a.direction)) << e;
     }
   }
+}
+TEST(Ltc, AnMatrixScaledByAPowerOfTwoSamplesAsTheUnscaledOneBitForBit) {
+  expect_power_of_two_scales_sample_as_the_unscaled_transform<float>({-60, -43, -20, 20, 42, 43, 60});
+  expect_power_of_two_scales_sample_as_the_unscaled_transform<double>({-400, -300, -200, -100, 100, 200, 275, 400});
+}
+
+// Random transforms U diag(sigma) V^T, sigma log-uniform in [10^-x, 10^x]: every sample of every view the kernel
+// accepts is a sample, whatever M's scale; 16 samples per accepted view. Without ltc_unit_scale, float at x = 20
+// (2000 M, 39 accepted) refused 12 samples and double at x = 110 (20000 M, 160 accepted) 32: |M c|^3 times the
+// projected density overflowed.
+template <class T> int refused_samples_of_accepted_views(double x, int trials, int* accepted) {
+  const auto pg = test_polygon().cast<T>();
+  std::mt19937_64 r(3);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::normal_distribution<double> n;
+  auto rotation = [&] {
+    Mat3<double> a;
+    for (int i = 0; i < 9; ++i) a(i) = n(r);
+    return Mat3<double>(Eigen::HouseholderQR<Mat3<double>>(a).householderQ());
+  };
+  int refused = 0;
+  *accepted = 0;
+  for (int t = 0; t < trials; ++t) {
+    Vec3<double> sigma;
+    for (int i = 0; i < 3; ++i) sigma[i] = std::pow(10.0, x * (2 * u(r) - 1));
+    Mat3<double> m = rotation() * sigma.asDiagonal() * rotation();
+    if (m.determinant() < 0) m.col(0) = -m.col(0);
+    const LtcPolygonView<T> v = make_ltc_polygon_view(LtcPolygonGeometry<T>{pg, m.cast<T>()});
+    if (!v.valid()) continue;
+    ++*accepted;
+    for (int i = 0; i < 16; ++i)
+      refused += !sample_ltc_polygon(v, Vec2<T>(T((i % 4 + 0.5) / 4), T((i / 4 + 0.5) / 4))).valid();
+  }
+  return refused;
+}
+TEST(Ltc, EverySampleOfAnAcceptedViewIsASampleWhateverTheScaleOfM) {
+  int accepted = 0;
+  EXPECT_EQ(refused_samples_of_accepted_views<float>(4, 2000, &accepted), 0);
+  EXPECT_GT(accepted, 1000);
+  EXPECT_EQ(refused_samples_of_accepted_views<float>(20, 2000, &accepted), 0);
+  EXPECT_GT(accepted, 30);
+  EXPECT_EQ(refused_samples_of_accepted_views<double>(8, 2000, &accepted), 0);
+  EXPECT_GT(accepted, 1000);
+  EXPECT_EQ(refused_samples_of_accepted_views<double>(110, 20000, &accepted), 0);
+  EXPECT_GT(accepted, 100);
 }
 
 // pdf() at the sampler's own direction gives the sampler's pdf, to the rounding of the density formula (16 eps, the
