@@ -154,7 +154,7 @@ std::vector<LtcConfig> ltc_configs() {
        "M = I (projected solid angle sampling), decentral rectangle",
        {decentral_rectangle(), Mat3<Real>::Identity()}},
       {"random", "a random LTC-like M (condition number ~3), decentral rectangle", {decentral_rectangle(), random}},
-      {"random-reversed",
+      {"reversed",
        "the random M, decentral rectangle with its vertices in the other order (Sec. 3.1's flipped y axis)",
        {clockwise(decentral_rectangle()), random}},
       {"ill-conditioned",
