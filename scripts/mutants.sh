@@ -47,8 +47,11 @@ Options:
   --help          this text
 
 A patch that does not apply to HEAD is a stale mutant: an error before anything runs (exit 2), never a survivor.
-Exit status: 0 when every mutant ran (whatever the score), 1 when a build of the unmutated tree fails, 2 on bad
-arguments or a stale mutant. Run it under nice: a battery stage at 10^7 samples takes minutes per family.
+Before the first mutant at a HEAD, the unmutated tree runs every fast gtest and fuzz replay (kept as passed in
+DIR/baseline/): a test that fails without a mutant would kill every mutant that reaches it.
+
+Exit status: 0 when every mutant ran (whatever the score), 1 when the unmutated tree fails to build or fails its
+own tests, 2 on bad arguments or a stale mutant. Run it under nice: a battery stage at 10^7 samples takes minutes per family.
 EOF
 }
 
@@ -251,6 +254,21 @@ stage2() {
   battery_stage "$family" 2 1000000 0 "$m"
 }
 stage3() { battery_stage "$1" 3 "$SAMPLES" "$RANDOM_N" "$2"; }
+
+# ---- the unmutated tree passes what the stages run, once per HEAD: a test that fails without a mutant kills none ----
+gtest_baseline() {
+  local ok="$DIR/baseline/tests-$HEAD_SHA.ok" log="$DIR/logs/baseline-tests.log"
+  [ -f "$ok" ] && return
+  case " $STAGES " in *" 1a "* | *" 1b "* | *" 2 "*) ;; *) return ;; esac
+  echo "[mutants] the unmutated tree's fast gtests and fuzz replays (once per HEAD)" >&2
+  reset_tree && build "$DIR/logs/baseline-build.log" "${ALL_TARGETS[@]}" || { echo "unmutated build failed" >&2; exit 1; }
+  "$TESTS" >"$log" 2>&1 && (cd "$BUILD" && ctest -R '^fuzz_replay\.' -j "$JOBS" >>"$log" 2>&1) || {
+    echo "mutants.sh: the unmutated tree fails its own tests (see $log): fix HEAD first" >&2
+    exit 1
+  }
+  touch "$ok"
+}
+gtest_baseline
 
 # ---- the run ----
 [ -f "$RESULTS" ] || printf 'mutant\tpatch_sha1\tsamples\toutcome\tstage\tkilled_by\tseconds\tutc\n' >"$RESULTS"
