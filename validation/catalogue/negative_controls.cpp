@@ -71,6 +71,8 @@ std::vector<SamplerUnderTest> negative_controls() {
   out.push_back(control(
       "pdf-disagrees-with-warp", [](double u0, double) { return u0; },
       [](Real t) { return 1 + Real(0.02) * (t - Real(0.5)); }));
+  out.push_back(control(
+      "pdf-1pct-low-everywhere", [](double u0, double) { return u0; }, [](Real) { return Real(0.99); }));
   return out;
 }
 

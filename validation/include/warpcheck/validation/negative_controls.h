@@ -9,6 +9,8 @@
 //                           t in [1.05, 1.2]; otherwise correct
 //   pdf-disagrees-with-warp samples are correct but sample and pdf() both report pdf (1 + 0.02 (t - 0.5)), which
 //                           still integrates to 1 and is not the warp's density
+//   pdf-1pct-low-everywhere samples are correct but sample and pdf() both report 0.99 of the density: a pdf that
+//                           integrates to less than 1 (a missing share of the mass)
 // Tests (validation/tests/test_negative_controls.cpp) assert that the battery rejects each at the default
 // sample count with a p-value below 1e-6; `warpcheck validate --negative-controls` runs them from the CLI.
 #pragma once
