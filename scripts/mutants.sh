@@ -40,8 +40,9 @@ Options:
                   that none of them kills is "open", not a survivor, and does not count in the score
   --resume        skip the mutants that already have a result in the TSV file for the same patch (and the same N
                   when the result came from stage 3); an "open" result is run again
-  --results FILE  the TSV file results are appended to (default DIR/results.tsv): mutant, patch sha1, samples,
-                  outcome (killed/survived/open), stage (1a, 1b, 2, 3 or -), what killed it, seconds, UTC time
+  --results FILE  the TSV file results are appended to (default data/mutants/results.tsv, kept in git): mutant,
+                  patch sha1, samples, outcome (killed/survived/open), stage (1a, 1b, 2, 3 or -), what killed it,
+                  seconds, UTC time
   --dir DIR       scratch directory (default build-mutants/ in the clone, ignored by git)
   --list          list the mutants and their slips, run nothing
   --help          this text
@@ -80,7 +81,7 @@ while [ $# -gt 0 ]; do
   esac
 done
 [ "$SAMPLES" -gt 0 ] || die "--samples needs a positive integer"
-RESULTS="${RESULTS:-$DIR/results.tsv}"
+RESULTS="${RESULTS:-$ROOT/data/mutants/results.tsv}"
 
 # ---- the families: kernels (warpcheck validate --kernel), gtest suites (stage 1), fuzz replays (kernel names) ----
 # A mutant's family is its file name up to the first '-'.
