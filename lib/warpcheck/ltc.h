@@ -72,9 +72,9 @@ template <class T> PolygonLightGeometry<T> ltc_transformed_polygon(const Polygon
 }
 
 // M^-1 P scaled exactly (by a power of two) so that its largest coordinate lies in [1, 2). Eq. 10 integrates over
-// M^-1 P as a cone of directions seen from the origin, which no positive scale changes (p_M is invariant under
-// M -> s M too), but its coordinates scale by 1 / s: unscaled, an M of scale 3e82 puts them at 1e-82, where
-// check_polygon's squared area (a product of four coordinates) underflows and the light is refused as zero-sized.
+// M^-1 P as a cone of directions seen from the origin, which no positive scale changes, but its coordinates are P's
+// (in the shading frame) times M^-1: a light far away or very close, or an ill-conditioned M, puts them where
+// check_polygon's squared area (a product of four coordinates) under- or overflows and the light is refused.
 template <class T> PolygonLightGeometry<T> ltc_unit_magnitude(PolygonLightGeometry<T> tg) {
   T magnitude = 0;
   for (int i = 0; i < tg.light.count; ++i) magnitude = std::max(magnitude, tg.light.vertices[i].cwiseAbs().maxCoeff());

@@ -126,7 +126,7 @@ PolygonLightGeometry<Real> decentral_rectangle() {
                                Vec3L(0.2L, 0.2L, 1.2L)};
   return g;
 }
-PolygonLightGeometry<Real> clockwise(PolygonLightGeometry<Real> g) {  // the same light, vertices in the other order
+PolygonLightGeometry<Real> reversed(PolygonLightGeometry<Real> g) {  // the same light, vertices in the other order
   std::reverse(g.light.vertices.begin(), g.light.vertices.begin() + g.light.count);
   return g;
 }
@@ -156,7 +156,7 @@ std::vector<LtcConfig> ltc_configs() {
       {"random", "a random LTC-like M (condition number ~3), decentral rectangle", {decentral_rectangle(), random}},
       {"reversed",
        "the random M, decentral rectangle with its vertices in the other order (Sec. 3.1's flipped y axis)",
-       {clockwise(decentral_rectangle()), random}},
+       {reversed(decentral_rectangle()), random}},
       {"ill-conditioned",
        "narrow lobe tilted towards the light: |M| = 1.2e-5, condition number ~300",
        {decentral_rectangle(), mat(0.004L, 0, 0.5L, 0, 0.003L, -0.1L, 0, 0, 1)}},

@@ -9,10 +9,8 @@
 // sphere-projected-cap-exact's sample.
 #include <gtest/gtest.h>
 
-#include <algorithm>
 #include <cmath>
 #include <functional>
-#include <iostream>
 #include <limits>
 #include <map>
 #include <numbers>
@@ -29,6 +27,11 @@ namespace {
 
 using L = long double;
 
+// The unit vector at polar angle `polar` from the z axis and azimuth `azimuth`, as the searches parameterise them.
+Vec3<L> unit_vector(L polar, L azimuth) {
+  return Vec3<L>(std::sin(polar) * std::cos(azimuth), std::sin(polar) * std::sin(azimuth), std::cos(polar));
+}
+
 // ---- polygon-backward-k*: Peters 2021 Sec. 3.6's backward error, through a polygon ----------------------------
 
 // The quad whose one decentral sector is the search's (searches/polygon.cpp: inner and outer edge normals from tilt
@@ -39,11 +42,8 @@ using L = long double;
 // direction w, so the normal (-n_xy, n_z) draws the same ellipse: where the search's two edges lie above the
 // horizon on opposite sides, the inner one is taken so reflected. nullopt where no turn puts all four above.
 std::optional<PolygonLightGeometry<L>> polygon_of_sector(const std::vector<L>& p) {
-  auto normal = [](L tilt, L azimuth) {
-    return Vec3<L>(std::sin(tilt) * std::cos(azimuth), std::sin(tilt) * std::sin(azimuth), std::cos(tilt));
-  };
-  Vec3<L> inner = normal(p[0], p[1]);
-  const Vec3<L> outer = normal(p[2], p[3]);
+  Vec3<L> inner = unit_vector(p[0], p[1]);
+  const Vec3<L> outer = unit_vector(p[2], p[3]);
   const L angle = p[4] * std::numbers::pi_v<L> / 180;
   const L mid_x = std::cos(angle / 2), mid_y = std::sin(angle / 2);
   if ((inner.x() * mid_x + inner.y() * mid_y) * (outer.x() * mid_x + outer.y() * mid_y) < 0)
@@ -107,7 +107,7 @@ template <CutDiskInverse M> L overhead_sphere_abscissa(L offset_area) {
 // that sector, has the recorded backward error to one part in 1e9 (the replay's slack) plus 64 long double epsilons
 // (the quad's edge normals and sector area come from its vertices by Kahan cross products, the search's from the
 // parameters: a rounding-level difference that only k3's 6.4e-11 notices, by 2.4e-19).
-bool replay_polygon_backward(const SearchRecord& r, int iterations) {
+void replay_polygon_backward(const SearchRecord& r, int iterations) {
   EXPECT_TRUE(polygon_of_sector(r.best_x)) << "the recorded sector is no polygon's";
   const std::optional<L> now = polygon_backward_error(r.best_x, iterations);
   EXPECT_TRUE(now) << "the kernel declined the polygon of the recorded sector";
@@ -115,7 +115,6 @@ bool replay_polygon_backward(const SearchRecord& r, int iterations) {
     EXPECT_NEAR(*now, r.best_f, 1e-9L * r.best_f + 64 * std::numeric_limits<L>::epsilon())
         << "recorded " << double(r.best_f) << ", through the kernel " << double(*now);
   }
-  return true;
 }
 
 // projected-cap-quintic records the published fit's error (paper_quintic_x). The kernel evaluates that fit at the
@@ -124,7 +123,7 @@ bool replay_polygon_backward(const SearchRecord& r, int iterations) {
 // and the lift to the sphere), and its error against the exact inverse is the rescaled fit's, below its maximum
 // 8.94e-5 (ProjectedCapQuintic.RescaledFitErrorAgainstTheExactInverse). The search's own measure at the same input,
 // taken on the exact sampler's abscissa, is the recorded error to the same rounding.
-bool replay_projected_cap_quintic(const SearchRecord& r) {
+void replay_projected_cap_quintic(const SearchRecord& r) {
   const L offset = r.best_x[0], pi = std::numbers::pi_v<L>;
   const L quintic = overhead_sphere_abscissa<CutDiskInverse::kQuintic>(offset);
   const L exact = overhead_sphere_abscissa<CutDiskInverse::kExact>(offset);
@@ -132,7 +131,6 @@ bool replay_projected_cap_quintic(const SearchRecord& r) {
   EXPECT_NEAR(quintic, paper_quintic_x<L>(pi - kQuinticKappa<L> * e), 1e-15L);
   EXPECT_NEAR(std::abs(paper_quintic_x<L>(pi / 2 + offset) - exact), r.best_f, 1e-15L);
   EXPECT_LE(std::abs(quintic - exact), 8.94e-5L);
-  return true;
 }
 
 // ---- sptd-cap-invariance: Eqs. 6-7's image cap, through the uniform SPTD's sampler -----------------------------
@@ -144,14 +142,11 @@ struct CapInvarianceInput {
   L alpha;
 };
 CapInvarianceInput cap_invariance_input(const std::vector<L>& p) {
-  auto dir = [](L polar, L azimuth) {
-    return Vec3<L>(std::sin(polar) * std::cos(azimuth), std::sin(polar) * std::sin(azimuth), std::cos(polar));
-  };
-  const Vec3<L> axis = dir(p[3], p[4]);
+  const Vec3<L> axis = unit_vector(p[3], p[4]);
   const L alpha = p[5], half = std::sin(alpha / 2);
   const Frame<L> f = Frame<L>::from_z(axis);
   const Vec3<L> w = std::cos(alpha) * axis + std::sin(alpha) * (std::cos(p[6]) * f.x + std::sin(p[6]) * f.y);
-  return {p[0] * dir(p[1], p[2]), w, Cap<L>{axis, 2 * half * half}, alpha};
+  return {p[0] * unit_vector(p[1], p[2]), w, Cap<L>{axis, 2 * half * half}, alpha};
 }
 
 // The search measures, in the image, the angle by which g(w) misses the boundary of g(C). Through the kernel: the
@@ -175,7 +170,7 @@ std::optional<L> sptd_boundary_error_through_the_sampler(const std::vector<L>& p
 // The record's input through the kernel has the search's error at that input (which the replay test holds to the
 // record) to 256 long double epsilons: the sample's own roundings (the image frame, the cap offset at u0 = 1, g and
 // the normalisation; 42 epsilons at the recorded input), the two sharing the rounding of g(C)'s 1 - cos.
-bool replay_sptd_cap_invariance(const SearchRecord& r) {
+void replay_sptd_cap_invariance(const SearchRecord& r) {
   const std::optional<L> now = sptd_boundary_error_through_the_sampler(r.best_x);
   EXPECT_TRUE(now) << "the uniform SPTD declined the recorded pivot and cap";
   if (now) {
@@ -183,12 +178,11 @@ bool replay_sptd_cap_invariance(const SearchRecord& r) {
     EXPECT_NEAR(*now, search, 256 * std::numeric_limits<L>::epsilon())
         << "the search's step " << double(search) << ", through the kernel " << double(*now);
   }
-  return true;
 }
 
-// How each recorded search is replayed through the kernels: a replay (true when it ran), or none where the search
+// How each recorded search is replayed through the kernels: a replay, or none where the search
 // already measures through the production entry point or its replay is not written (file comment).
-std::optional<std::function<bool(const SearchRecord&)>> production_replay(const std::string& search) {
+std::optional<std::function<void(const SearchRecord&)>> production_replay(const std::string& search) {
   const std::map<std::string, int> backward = {{"polygon-backward-k0", 0},
                                                {"polygon-backward-k1", 1},
                                                {"polygon-backward-k2", 2},
@@ -217,7 +211,8 @@ TEST(RecordedWorstCasesThroughTheKernels, HaveTheRecordedErrorThroughTheKernelsS
     const SearchRecord r = read_recorded_worst_case(name);
     SCOPED_TRACE(r.search);
     if (const auto replay = production_replay(r.search)) {
-      replayed += (*replay)(r);
+      (*replay)(r);
+      ++replayed;
       continue;
     }
     EXPECT_TRUE(measured_through_the_production_entry_point(r.search))
