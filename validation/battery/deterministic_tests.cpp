@@ -55,7 +55,7 @@ namespace {
 // sampler's, so it is not compared.)
 TestResult pdf_self_consistency(const SamplerUnderTest& s, const BatteryOptions& o) {
   TestResult r = make_result(s, "pdf-consistency");
-  std::mt19937_64 g = stream(o.seed, s, 2, 0);
+  Rng g = stream(o.seed, s, 2, 0);
   std::vector<double> u;
   Real worst = 0;
   std::size_t checked = 0, declined = 0;
@@ -88,7 +88,7 @@ TestResult pdf_consistency(const SamplerUnderTest& s, const BatteryOptions& o) {
   const auto& warp = s.reference_sample ? s.reference_sample : std::function<Sample(Real, Real)>([&](Real a, Real b) {
     return s.sample(double(a), double(b));
   });
-  std::mt19937_64 g = stream(o.seed, s, 2, 0);
+  Rng g = stream(o.seed, s, 2, 0);
   Real worst_self = 0, worst_jac = 0;
   Real worst_u[2] = {0, 0};
   std::size_t checked = 0, skipped = 0, declined = 0, unresolved = 0;
@@ -167,7 +167,7 @@ std::vector<TestResult> normalizations(const SamplerUnderTest& s) {
 // For geometry that has no sample: every draw declines and the pdf is zero at random directions.
 TestResult no_sample(const SamplerUnderTest& s, const BatteryOptions& o) {
   TestResult r = make_result(s, "no-sample");
-  std::mt19937_64 g = stream(o.seed, s, 3, 0);
+  Rng g = stream(o.seed, s, 3, 0);
   std::size_t produced = 0, nonzero_pdf = 0;
   const int n = o.consistency_points;
   for (int k = 0; k < n; ++k) {

@@ -27,11 +27,15 @@ std::uint64_t fnv1a(const std::string& s, std::uint64_t h = 1469598103934665603U
 
 }  // namespace
 
-std::mt19937_64 stream(std::uint64_t seed, const SamplerUnderTest& s, std::uint64_t purpose, std::uint64_t chunk) {
+std::uint64_t stream_seed(std::uint64_t seed, const SamplerUnderTest& s, std::uint64_t purpose, std::uint64_t chunk) {
   std::uint64_t x = seed ^ fnv1a(s.kernel + '\x1f' + s.scalar + '\x1f' + s.config);
   x ^= splitmix64(x) + purpose * 0x632be59bd9b4e019ULL;
   x ^= splitmix64(x) + chunk;
-  return std::mt19937_64(splitmix64(x));
+  return splitmix64(x);
+}
+
+Rng stream(std::uint64_t seed, const SamplerUnderTest& s, std::uint64_t purpose, std::uint64_t chunk) {
+  return Rng(stream_seed(seed, s, purpose, chunk));
 }
 
 Real scalar_epsilon(const std::string& scalar) {
@@ -40,7 +44,7 @@ Real scalar_epsilon(const std::string& scalar) {
   return DBL_EPSILON;
 }
 
-Sample draw_one(const SamplerUnderTest& s, std::mt19937_64& g, std::vector<double>& u) {
+Sample draw_one(const SamplerUnderTest& s, Rng& g, std::vector<double>& u) {
   u.resize(std::size_t(s.uniforms));
   for (double& x : u) x = uniform01(g);
   return sample_at(s, u);
@@ -88,6 +92,15 @@ void check_block_forms(const SamplerUnderTest& s) {
       u[0] = u0[i], u[1] = u1[i];
       block[i] = sample_at(s, u);
     }
+  }
+  if (s.sample_block_double) {
+    std::array<double, u0.size()> x, y, z, pdf;
+    std::array<bool, u0.size()> valid;
+    s.sample_block_double(u0, u1, {x, y, z, pdf, valid});
+    for (std::size_t i = 0; i < u0.size(); ++i)
+      if (!same(Sample{Vec3L(x[i], y[i], z[i]), pdf[i], valid[i]}, block[i]))
+        block_form_disagrees(s, "sample_block_double", s.sample_block ? "sample_block" : "sample",
+                             "u = (" + std::to_string(u0[i]) + ", " + std::to_string(u1[i]) + ")");
   }
   if (!s.pdf_block) return;
   // The samples' directions (where the pdf is nonzero, however thin the support) and points of the bounding cap.
@@ -213,33 +226,32 @@ struct Tally {
   std::vector<std::uint64_t> counts, radial, azimuth;
   std::uint64_t outside = 0, declined = 0, non_finite = 0, exact = 0;
 
+  // A block's samples in double (sample_block_double's output; the directions are zeroed where a sample is not
+  // placed) and whether each is finite in the sampler's own type.
+  struct Block {
+    std::array<double, kBlock> x, y, z, pdf;
+    std::array<bool, kBlock> valid, finite;
+  };
+
   explicit Tally(const Draws& d)
       : counts(d.counts.size()), radial(d.radial_slabs.size()), azimuth(d.azimuth_slabs.size()) {}
 
   // The block's samples placed by place_fast in two passes (the coordinates of the whole block, then each
   // placement), or by place_exact.
   void add(const CapBinner& b, std::span<const Sample> block) {
-    std::array<double, kBlock> x, y, z, t, a;
-    std::array<bool, kBlock> placed;
+    Block d;
     for (std::size_t i = 0; i < block.size(); ++i) {
       const Sample& s = block[i];
-      const bool finite = all_finite(s.direction) && std::isfinite(s.pdf);
-      declined += !s.valid, non_finite += s.valid && !finite;
-      placed[i] = s.valid && finite;
-      x[i] = placed[i] ? double(s.direction.x()) : 0, y[i] = placed[i] ? double(s.direction.y()) : 0;
-      z[i] = placed[i] ? double(s.direction.z()) : 0;
+      d.x[i] = double(s.direction.x()), d.y[i] = double(s.direction.y()), d.z[i] = double(s.direction.z());
+      d.valid[i] = s.valid, d.finite[i] = all_finite(s.direction) && std::isfinite(s.pdf);
     }
-    b.fast_coordinates(block.size(), x.data(), y.data(), z.data(), t.data(), a.data());
-    for (std::size_t i = 0; i < block.size(); ++i) {
-      if (!placed[i]) continue;
-      std::optional<Placement> p = b.place_coordinates(t[i], a[i]);
-      if (!p) p = b.place_exact(block[i].direction), ++exact;
-      if (p->outside) {
-        ++outside;
-        continue;
-      }
-      ++counts[p->bin], ++radial[p->radial_slab], ++azimuth[p->azimuth_slab];
-    }
+    count(b, block.size(), d, [&](std::size_t i) { return block[i].direction; });
+  }
+  // The same for samples in double (sample_block_double): their directions are the Samples' exactly.
+  void add(const CapBinner& b, std::size_t n, Block& d) {
+    for (std::size_t i = 0; i < n; ++i)
+      d.finite[i] = std::isfinite(d.x[i]) && std::isfinite(d.y[i]) && std::isfinite(d.z[i]) && std::isfinite(d.pdf[i]);
+    count(b, n, d, [&](std::size_t i) { return Vec3L(d.x[i], d.y[i], d.z[i]); });
   }
 
   void merge_into(Draws& d) const {
@@ -248,6 +260,28 @@ struct Tally {
     };
     add_to(d.counts, counts), add_to(d.radial_slabs, radial), add_to(d.azimuth_slabs, azimuth);
     d.outside += outside, d.declined += declined, d.non_finite += non_finite, d.placed_exactly += exact;
+  }
+
+ private:
+  template <class Direction> void count(const CapBinner& b, std::size_t n, Block& d, Direction direction) {
+    std::array<double, kBlock> t, a;
+    std::array<bool, kBlock> placed;
+    for (std::size_t i = 0; i < n; ++i) {
+      declined += !d.valid[i], non_finite += d.valid[i] && !d.finite[i];
+      placed[i] = d.valid[i] && d.finite[i];
+      if (!placed[i]) d.x[i] = d.y[i] = d.z[i] = 0;
+    }
+    b.fast_coordinates(n, d.x.data(), d.y.data(), d.z.data(), t.data(), a.data());
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!placed[i]) continue;
+      std::optional<Placement> p = b.place_coordinates(t[i], a[i]);
+      if (!p) p = b.place_exact(direction(i)), ++exact;
+      if (p->outside) {
+        ++outside;
+        continue;
+      }
+      ++counts[p->bin], ++radial[p->radial_slab], ++azimuth[p->azimuth_slab];
+    }
   }
 };
 
@@ -265,16 +299,25 @@ Draws draw(const SamplerUnderTest& s, const BatteryOptions& o, const std::vector
   std::mutex m;
   std::size_t done = 0;
   parallel_for(chunks, thread_count(o), [&](std::size_t c) {
-    std::mt19937_64 g = stream(o.seed, s, 1, c);
+    Rng g = stream(o.seed, s, 1, c);
     Tally tally(d);
     std::array<double, kBlock> u0, u1;
     std::array<Sample, kBlock> block;
+    Tally::Block doubles;
     const std::size_t end = std::min<std::size_t>(o.samples, (c + 1) * kChunk);
     std::vector<double> u(std::size_t(s.uniforms));
     for (std::size_t b = c * kChunk; b < end; b += kBlock) {
       const std::size_t n = std::min(kBlock, end - b);
       if (s.sample_u) {
         for (std::size_t j = 0; j < n; ++j) block[j] = draw_one(s, g, u);
+      } else if (s.sample_block_double) {
+        for (std::size_t j = 0; j < n; ++j) u0[j] = uniform01(g), u1[j] = uniform01(g);
+        Tally::Block& e = doubles;
+        s.sample_block_double(
+            {u0.data(), n}, {u1.data(), n},
+            {{e.x.data(), n}, {e.y.data(), n}, {e.z.data(), n}, {e.pdf.data(), n}, {e.valid.data(), n}});
+        tally.add(binner, n, e);
+        continue;
       } else {
         for (std::size_t j = 0; j < n; ++j) u0[j] = uniform01(g), u1[j] = uniform01(g);
         sample_many(s, {u0.data(), n}, {u1.data(), n}, {block.data(), n});
@@ -291,7 +334,7 @@ Draws draw(const SamplerUnderTest& s, const BatteryOptions& o, const std::vector
 TestResult weight_check(const SamplerUnderTest& s, const BatteryOptions& o) {
   TestResult r;
   r.kernel = s.kernel, r.scalar = s.scalar, r.config = s.config, r.test = "weight";
-  std::mt19937_64 g = stream(o.seed, s, 4, 0);
+  Rng g = stream(o.seed, s, 4, 0);
   std::vector<double> u;
   const std::size_t n = std::min<std::uint64_t>(o.samples, kWeightSamples);
   std::size_t checked = 0, missing = 0, wrong = 0;

@@ -37,7 +37,7 @@ SamplerUnderTest inject(SamplerUnderTest s, std::function<double(double, double)
       u0 = uniform(), u1 = uniform();
     }
   };
-  s.sample_block = nullptr;  // the block form would bypass the injected error
+  s.sample_block = nullptr, s.sample_block_double = nullptr;  // the block forms would bypass the injected error
   return s;
 }
 

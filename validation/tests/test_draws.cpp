@@ -198,5 +198,48 @@ TEST(Draws, CountsDoNotDependOnTheThreadCountAndAddUpToTheSamples) {
   }
 }
 
+TEST(Draws, ThroughTheDoubleBlockFormAreTheDrawsThroughSamples) {
+  const Registry reg = default_registry();
+  int compared = 0;
+  for (const Case* c : reg.select({"sphere-solid-angle", "polygon-solid-angle", "sphere-projected-cap"},
+                                  {"near", "below-horizon", "triangle", "case3"})) {
+    const SamplerUnderTest s = c->make();
+    if (c->scalar == "long double") {
+      EXPECT_FALSE(s.sample_block_double) << "long double does not round to double exactly";
+      continue;
+    }
+    ASSERT_TRUE(s.sample_block_double) << c->kernel << " / " << c->scalar << " / " << c->config;
+    SamplerUnderTest through_samples = s;
+    through_samples.sample_block_double = nullptr;
+    BatteryOptions o;
+    o.samples = 100'003;
+    const std::vector<Real> xr = clustered_nodes(o.ks_cdf_nodes), xa = clustered_nodes(o.ks_cdf_nodes);
+    const Draws a = draw(s, o, xr, xa), b = draw(through_samples, o, xr, xa);
+    const std::string name = c->kernel + " / " + c->scalar + " / " + c->config;
+    EXPECT_EQ(a.counts, b.counts) << name;
+    EXPECT_EQ(a.radial_slabs, b.radial_slabs) << name;
+    EXPECT_EQ(a.azimuth_slabs, b.azimuth_slabs) << name;
+    EXPECT_EQ(a.outside, b.outside) << name;
+    EXPECT_EQ(a.declined, b.declined) << name;
+    EXPECT_EQ(a.non_finite, b.non_finite) << name;
+    EXPECT_EQ(a.placed_exactly, b.placed_exactly) << name;
+    ++compared;
+  }
+  EXPECT_GE(compared, 8);
+}
+
+TEST(BatteryStream, IsTheStandardMersenneTwister) {
+  SamplerUnderTest s;
+  s.kernel = "k", s.scalar = "double", s.config = "c";
+  for (std::uint64_t seed : {std::uint64_t(0), std::uint64_t(1), ~std::uint64_t(0)}) {
+    Rng battery = stream(seed, s, 1, 3), plain(seed);
+    std::mt19937_64 standard(stream_seed(seed, s, 1, 3)), standard_plain(seed);
+    for (int k = 0; k < 100'000; ++k) {
+      ASSERT_EQ(battery(), standard()) << "seed " << seed << ", number " << k;
+      ASSERT_EQ(plain(), standard_plain()) << "seed " << seed << ", number " << k;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace warpcheck::validation::battery

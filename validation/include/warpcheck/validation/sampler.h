@@ -66,6 +66,13 @@ struct Normalization {
   Real reference = 0;            // computed independently of the kernel's code
 };
 
+// A block of samples in double, as arrays: sample i is the direction (x[i], y[i], z[i]) with density pdf[i], declined
+// where valid[i] is false (as Sample).
+struct DoubleSamples {
+  std::span<double> x, y, z, pdf;
+  std::span<bool> valid;
+};
+
 struct SamplerUnderTest {
   std::string kernel;  // kernel name, e.g. "sphere-solid-angle"
   std::string scalar;  // "float", "double", "long double" or whatever the sampler computes in
@@ -123,6 +130,10 @@ struct SamplerUnderTest {
   // pdf_many below fall back to the single forms.
   std::function<void(std::span<const double> u0, std::span<const double> u1, std::span<Sample> out)> sample_block;
   std::function<void(std::span<const Vec3L> w, std::span<Real> out)> pdf_block;
+  // Optional, for a sampler that computes in float or double (both exact in double): sample_block with its output in
+  // double, which the battery bins without converting each sample to long double and back. bind_kernel fills it
+  // for float and double kernels.
+  std::function<void(std::span<const double> u0, std::span<const double> u1, DoubleSamples out)> sample_block_double;
   // Geometry for which the sampler must decline every sample (e.g. a light entirely below the horizon):
   // the battery then checks only that every sample is declined and the pdf is zero everywhere.
   bool expect_no_sample = false;
@@ -248,6 +259,15 @@ template <Kernel K> SamplerUnderTest bind_kernel(std::string config, const typen
   s.pdf_block = [v = K::view(g)](std::span<const Vec3L> w, std::span<Real> out) {
     for (std::size_t i = 0; i < out.size(); ++i) out[i] = Real(K::pdf(v, w[i].template cast<T>()));
   };
+  if constexpr (std::is_same_v<T, float> || std::is_same_v<T, double>)
+    s.sample_block_double = [v = K::view(g)](std::span<const double> u0, std::span<const double> u1,
+                                             DoubleSamples out) {
+      for (std::size_t i = 0; i < out.x.size(); ++i) {
+        const DirectionSample<T> x = K::sample(v, Vec2<T>(to_unit<T>(u0[i]), to_unit<T>(u1[i])));
+        out.x[i] = x.direction.x(), out.y[i] = x.direction.y(), out.z[i] = x.direction.z();
+        out.pdf[i] = x.pdf, out.valid[i] = x.valid();
+      }
+    };
   const Cap<T> cap = K::bounding_cap(g);
   s.bounding_cap = Cap<Real>{to_long(cap.axis).normalized(), Real(cap.one_minus_cos)};
   s.kinks_u0 = kernel_kinks<K>(g, 0);
