@@ -88,7 +88,7 @@ RESULTS="${RESULTS:-$ROOT/data/mutants/results.tsv}"
 family_kernels() {
   case "$1" in
     sphere) echo "sphere-solid-angle sphere-visible-area" ;;
-    pcap) echo "sphere-projected-cap sphere-projected-cap-exact" ;;
+    pcap) echo "sphere-projected-cap sphere-projected-cap-exact sphere-projected-cap-polar" ;;
     psa) echo "polygon-solid-angle polygon-solid-angle-clipped" ;;
     ppsa) echo "polygon-projected-solid-angle polygon-projected-solid-angle-biased" ;;
     ltc) echo "polygon-ltc" ;;

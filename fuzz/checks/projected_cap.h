@@ -202,17 +202,21 @@ ProjectedCapDraws<T> decode_projected_cap_draws(FuzzedDataProvider& in, const Pr
 
 // One inverse's samples and densities (header comment's invariants). The pdf comparison is probed
 // (check_pdf_consistency_probed): the warp's pieces and the quintic's fold make the density piecewise smooth.
-template <class T, CutDiskInverse M> void check_projected_cap_kernel(const ProjectedCapCase<T>& c,
-                                                                     const ProjectedCapDraws<T>& draws,
-                                                                     const Mutation& mutate) {
-  const char* name = SphereProjectedCapKernel<T, M>::name;
+// Polar: sphere-projected-cap-polar (Case 1 by polar coordinates, M the quintic).
+template <class T, CutDiskInverse M, bool Polar = false>
+void check_projected_cap_kernel(const ProjectedCapCase<T>& c, const ProjectedCapDraws<T>& draws,
+                                const Mutation& mutate) {
+  const char* name = Polar ? SphereProjectedCapPolar<T>::name : SphereProjectedCapKernel<T, M>::name;
   const ProjectedCapView<T>& view = c.view;
   const ProjectedCapTolerances<T> tols(c.ref, view.which_case);
   const L e = tols.e;
-  auto pdf = [&](const Vec3<T>& w) { return mutate.pdf(pdf_projected_spherical_cap<T, M>(view, w)); };
+  auto pdf = [&](const Vec3<T>& w) {
+    return mutate.pdf(Polar ? pdf_projected_spherical_cap_polar(view, w) : pdf_projected_spherical_cap<T, M>(view, w));
+  };
   for (int k = 0; k < draws.samples; ++k) {
     const Vec2<T> u = draws.u[k];
-    const DirectionSample<T> s = mutate.sample(sample_projected_spherical_cap<T, M>(view, u));
+    const DirectionSample<T> s = mutate.sample(Polar ? sample_projected_spherical_cap_polar(view, u)
+                                                     : sample_projected_spherical_cap<T, M>(view, u));
     const std::string geo = describe(c.g, u, name) + "case " + std::to_string(view.which_case) + "\n";
     check_sample_shape(s, geo);
     if (!c.finite_input) WARPCHECK_FUZZ_REQUIRE(!s.valid(), "a sample from non-finite input", geo);
@@ -247,12 +251,14 @@ template <class T, CutDiskInverse M> void check_projected_cap_kernel(const Proje
 // The target of one inverse: the view's normaliser, then the inverse's samples and densities. An input holds the
 // draws of the quintic, then those of the exact inverse (one target checked both before they were split, and the
 // stored inputs decode as they did); each target checks its own.
-template <class T, CutDiskInverse M> void check_projected_cap(FuzzedDataProvider& in, const Mutation& mutate = {}) {
+// sphere-projected-cap-polar decodes as the quintic's target (its corpus seeded from that one's).
+template <class T, CutDiskInverse M, bool Polar = false>
+void check_projected_cap(FuzzedDataProvider& in, const Mutation& mutate = {}) {
   const ProjectedCapCase<T> c = decode_projected_cap_case<T>(in);
   check_projected_cap_normaliser<T, M>(c, mutate);
   ProjectedCapDraws<T> draws = decode_projected_cap_draws(in, c.view);
   if (M == CutDiskInverse::kExact) draws = decode_projected_cap_draws(in, c.view);
-  check_projected_cap_kernel<T, M>(c, draws, mutate);
+  check_projected_cap_kernel<T, M, Polar>(c, draws, mutate);
 }
 
 }  // namespace warpcheck::fuzz

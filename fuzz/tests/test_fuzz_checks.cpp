@@ -65,6 +65,7 @@ const std::vector<Family> kFamilies = [] {
   std::vector<Family> v;
   add<SphereProjectedCap>(v);
   add<SphereProjectedCapExact>(v);
+  add<SphereProjectedCapPolar>(v);
   add<PolygonLtc>(v);
   add<SptdUniformCap>(v);
   add<SptdCosineCap>(v);

@@ -59,7 +59,7 @@ struct JoinKernelLists<KernelList<A...>, KernelList<B...>, Rest...> {
 
 // The families: one battery registrar each (validation/catalogue/<family>.cpp).
 using SphereKernels = KernelList<SphereSolidAngle, SphereVisibleArea>;
-using ProjectedCapKernels = KernelList<SphereProjectedCap, SphereProjectedCapExact>;
+using ProjectedCapKernels = KernelList<SphereProjectedCap, SphereProjectedCapExact, SphereProjectedCapPolar>;
 using PolygonKernels =
     KernelList<PolygonProjectedSolidAngle, PolygonProjectedSolidAngleBiased, PolygonSolidAngle,
                PolygonSolidAngleClipped, BaselineArvoTriangle, BaselineTurkArea, BaselineUrenaRectangle>;

@@ -627,6 +627,58 @@ bool invert_projected_spherical_cap(const ProjectedCapView<T>& p, const Vec3<T>&
   return projected_cap_detail::pdf_local<T, M>(p, wl, &u) > T(0);
 }
 
+// ---- Case 1 by polar coordinates (Sec. 3.4), an option: the paper's discontinuous alternative ----
+
+// When the cap is entirely above the horizon (Case 1), the projected cap is the ellipse, sampled uniformly by the
+// polar map of the unit disk, r = sqrt(u0), phi = 2 pi u1, scaled to the ellipse; Cases 2-3 by the quintic sampler.
+// The warp jumps where the light reaches the horizon (Sec. 3.4 prefers the continuous map for stratification).
+// Heights as disk_to_local's: 1 - w_x^2 - w_y^2 = (c_z - r_z d_x)^2 + r_y^2 (1 - r^2), with, for d_x > 0,
+// 1 - d_x = (1 - u0) / (1 + r) + 2 r sin^2(phi / 2), both terms >= 0: no cancellation.
+template <class T>
+DirectionSample<T> sample_projected_spherical_cap_polar(const ProjectedCapView<T>& p, const Vec2<T>& u) {
+  if (!p.valid() || p.which_case != 1) return sample_projected_spherical_cap<T>(p, u);
+  if (!std::isfinite(u[0]) || !std::isfinite(u[1])) return DirectionSample<T>::none(NoSample::kNonFinite);
+  const T u0 = std::min(std::max(u[0], T(0)), T(1)), u1 = std::min(std::max(u[1], T(0)), T(1));
+  const T r = std::sqrt(u0), phi = kTwoPi<T> * u1;
+  const T dx = r * std::cos(phi), dy = r * std::sin(phi);
+  T low;
+  if (dx > T(0)) {
+    const T half = std::sin(phi / T(2));
+    low = p.cz_minus_rz + p.r_z * ((T(1) - u0) / (T(1) + r) + T(2) * r * (half * half));
+  } else {
+    low = p.c_z - p.r_z * dx;
+  }
+  const T w_z = std::sqrt(low * low + (p.r_y * p.r_y) * (T(1) - u0));
+  const T pdf = w_z / p.area_e;
+  if (!(pdf > T(0)) || !std::isfinite(pdf)) return DirectionSample<T>::none(NoSample::kOnSilhouette);
+  DirectionSample<T> s;
+  s.direction = renormalized(p.to_world(Vec3<T>(p.r_x * dx + p.c_x, p.r_y * dy, w_z)));
+  s.pdf = pdf;
+  return s;
+}
+
+// Its density per solid angle: w_z / A_E on the ellipse in Case 1 (the disk test of local_to_disk), else the
+// quintic sampler's. With u, also the preimage: u0 = |d|^2, u1 = atan2(d_y, d_x) / 2 pi in [0, 1).
+template <class T>
+T pdf_projected_spherical_cap_polar(const ProjectedCapView<T>& p, const Vec3<T>& w, Vec2<T>* u = nullptr) {
+  if (!p.valid() || !all_finite(w)) return T(0);
+  const Vec3<T> wl = p.to_local(w.normalized());
+  if (!(wl.z() > T(0))) return T(0);
+  if (p.which_case != 1) {
+    const T pdf = projected_cap_detail::pdf_local<T, CutDiskInverse::kQuintic>(p, wl, u) * wl.z();
+    return std::isfinite(pdf) ? pdf : T(0);
+  }
+  T dx, dy, hh, area;
+  if (!projected_cap_detail::local_to_disk(p, 0, wl, dx, dy, hh, area)) return T(0);
+  if (u) {
+    const T phi = std::atan2(dy, dx);
+    (*u)[0] = std::min(T(1), dx * dx + dy * dy);
+    (*u)[1] = phi >= T(0) ? phi / kTwoPi<T> : std::min(std::nextafter(T(1), T(0)), T(1) + phi / kTwoPi<T>);
+  }
+  const T pdf = wl.z() / p.area_e;
+  return std::isfinite(pdf) ? pdf : T(0);
+}
+
 // The light's cap widened by 64 eps_T radians: the pieces tile it exactly, and the battery's quadrature must see the
 // support reach the cap's edge.
 template <class T> Cap<T> projected_cap_bounding_cap(const ProjectedCapView<T>& p) {
@@ -688,5 +740,25 @@ template <class T, CutDiskInverse M> struct SphereProjectedCapKernel {
 };
 template <class T> using SphereProjectedCap = SphereProjectedCapKernel<T, CutDiskInverse::kQuintic>;
 template <class T> using SphereProjectedCapExact = SphereProjectedCapKernel<T, CutDiskInverse::kExact>;
+
+// The quintic sampler with Case 1 by polar coordinates (sample_projected_spherical_cap_polar).
+template <class T> struct SphereProjectedCapPolar : SphereProjectedCap<T> {
+  using View = ProjectedCapView<T>;
+  static constexpr const char* name = "sphere-projected-cap-polar";
+  static constexpr const char* description =
+      "projected solid angle, Peters & Dachsbacher 2019, Case 1 by polar coordinates (Sec. 3.4)";
+  static DirectionSample<T> sample(const View& v, const Vec2<T>& u) {
+    return sample_projected_spherical_cap_polar(v, u);
+  }
+  static T pdf(const View& v, const Vec3<T>& w) { return pdf_projected_spherical_cap_polar(v, w); }
+  static bool invert(const View& v, const Vec3<T>& w, Vec2<T>& u) {
+    return pdf_projected_spherical_cap_polar(v, w, &u) > T(0);
+  }
+  // Case 1: none (the polar map is smooth for u0 > 0, and u1's seam is periodic); Cases 2-3: the quintic's.
+  static std::vector<T> kinks_u0(const SphereLightGeometry<T>& g) {
+    const View v = make_projected_cap_view(g);
+    return v.valid() && v.which_case == 1 ? std::vector<T>{} : SphereProjectedCap<T>::kinks_u0(g);
+  }
+};
 
 }  // namespace warpcheck

@@ -32,12 +32,13 @@ template <CutDiskInverse M> std::vector<std::pair<Real, Real>> projected_cap_ban
 Real cap_cosine_moment(const SphereLightGeometry<Real>& g, int power);
 
 // Moments of the Lambertian irradiance estimator X = cos / pdf (unit radiance) of the kernel in T with cut-disk
-// inverse M, over primary sample space by nested tanh-sinh quadrature in long double (deterministic):
-// m1 = E[X], m1_in = E[X; the ray hits the light], m2 = E[X^2].
+// inverse M (Polar: with Case 1 by polar coordinates, sphere-projected-cap-polar), over primary sample space by
+// nested tanh-sinh quadrature in long double (deterministic): m1 = E[X], m1_in = E[X; the ray hits the light],
+// m2 = E[X^2].
 struct LambertianMoments {
   Real m1 = 0, m1_in = 0, m2 = 0;
 };
-template <class T, CutDiskInverse M>
+template <class T, CutDiskInverse M, bool Polar = false>
 LambertianMoments projected_cap_lambertian_moments(const SphereLightGeometry<Real>& g, Real tol = 1e-10L,
                                                    bool mean_only = false);
 

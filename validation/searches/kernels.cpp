@@ -150,8 +150,9 @@ template <> struct FamilyOf<SptdCapGeometry<L>> { using type = SptdCapFamily; };
 template <> struct FamilyOf<LtcPolygonGeometry<L>> { using type = LtcRectangleFamily; };
 
 // Catalogue kernels without searches (yet); each would add its five.
-constexpr std::string_view kNotSearched[] = {"sphere-projected-cap-exact", "polygon-projected-solid-angle-biased",
-                                             "polygon-solid-angle-clipped", "sptd-cosine-cap"};
+constexpr std::string_view kNotSearched[] = {"sphere-projected-cap-exact", "sphere-projected-cap-polar",
+                                             "polygon-projected-solid-angle-biased", "polygon-solid-angle-clipped",
+                                             "sptd-cosine-cap"};
 
 // ---- Measures ----------------------------------------------------------------------------------------------
 

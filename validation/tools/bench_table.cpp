@@ -65,8 +65,7 @@ std::optional<double> paper_polygon_ratio(bool central, int n, int spl) {
 
 // The setup-overhead target of a kernel in a configuration (1 spl / 500 spl), if the issue sets one.
 std::optional<double> setup_target(const std::string& kernel, const std::string& config) {
-  if (kernel == "sphere-solid-angle" || kernel == "sphere-projected-cap" || kernel == "sphere-projected-cap-exact")
-    return 1.5;
+  if (kernel == "sphere-solid-angle" || kernel.starts_with("sphere-projected-cap")) return 1.5;
   const bool tri_or_quad = config.ends_with("-3") || config.ends_with("-4");
   if (tri_or_quad && (kernel == "polygon-solid-angle" || kernel == "polygon-projected-solid-angle" ||
                       kernel == "baseline-arvo-triangle" || kernel == "baseline-urena-rectangle"))
