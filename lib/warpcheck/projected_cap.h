@@ -657,26 +657,39 @@ DirectionSample<T> sample_projected_spherical_cap_polar(const ProjectedCapView<T
   return s;
 }
 
-// Its density per solid angle: w_z / A_E on the ellipse in Case 1 (the disk test of local_to_disk), else the
-// quintic sampler's. With u, also the preimage: u0 = |d|^2, u1 = atan2(d_y, d_x) / 2 pi in [0, 1).
-template <class T>
-T pdf_projected_spherical_cap_polar(const ProjectedCapView<T>& p, const Vec3<T>& w, Vec2<T>* u = nullptr) {
-  if (!p.valid() || !all_finite(w)) return T(0);
-  const Vec3<T> wl = p.to_local(w.normalized());
-  if (!(wl.z() > T(0))) return T(0);
-  if (p.which_case != 1) {
-    const T pdf = projected_cap_detail::pdf_local<T, CutDiskInverse::kQuintic>(p, wl, u) * wl.z();
-    return std::isfinite(pdf) ? pdf : T(0);
-  }
-  T dx, dy, hh, area;
-  if (!projected_cap_detail::local_to_disk(p, 0, wl, dx, dy, hh, area)) return T(0);
-  if (u) {
-    const T phi = std::atan2(dy, dx);
-    (*u)[0] = std::min(T(1), dx * dx + dy * dy);
-    (*u)[1] = phi >= T(0) ? phi / kTwoPi<T> : std::min(std::nextafter(T(1), T(0)), T(1) + phi / kTwoPi<T>);
-  }
+namespace projected_cap_detail {
+// Case 1 of the polar option: the local direction of w and its point d on the unit disk (local_to_disk's test and
+// its d_x without cancellation); false off the ellipse or at or below the horizon.
+template <class T> bool polar_case1_disk(const ProjectedCapView<T>& p, const Vec3<T>& w, Vec3<T>& wl, T& dx, T& dy) {
+  if (!all_finite(w)) return false;
+  wl = p.to_local(w.normalized());
+  T hh, area;
+  return wl.z() > T(0) && local_to_disk(p, 0, wl, dx, dy, hh, area);
+}
+}  // namespace projected_cap_detail
+
+// Its density per solid angle: w_z / A_E on the ellipse in Case 1, else the quintic sampler's.
+template <class T> T pdf_projected_spherical_cap_polar(const ProjectedCapView<T>& p, const Vec3<T>& w) {
+  if (!p.valid() || p.which_case != 1) return pdf_projected_spherical_cap<T>(p, w);
+  Vec3<T> wl;
+  T dx, dy;
+  if (!projected_cap_detail::polar_case1_disk(p, w, wl, dx, dy)) return T(0);
   const T pdf = wl.z() / p.area_e;
   return std::isfinite(pdf) ? pdf : T(0);
+}
+
+// Its inverse: in Case 1 u0 = |d|^2, u1 = atan2(d_y, d_x) / 2 pi in [0, 1); else the quintic sampler's.
+template <class T>
+bool invert_projected_spherical_cap_polar(const ProjectedCapView<T>& p, const Vec3<T>& w, Vec2<T>& u) {
+  if (!p.valid() || p.which_case != 1) return invert_projected_spherical_cap<T>(p, w, u);
+  Vec3<T> wl;
+  T dx, dy;
+  if (!projected_cap_detail::polar_case1_disk(p, w, wl, dx, dy)) return false;
+  const T phi = std::atan2(dy, dx);
+  u[0] = std::min(T(1), dx * dx + dy * dy);
+  u[1] = phi >= T(0) ? phi / kTwoPi<T> : std::min(std::nextafter(T(1), T(0)), T(1) + phi / kTwoPi<T>);
+  const T pdf = wl.z() / p.area_e;
+  return std::isfinite(pdf) && pdf > T(0);
 }
 
 // The light's cap widened by 64 eps_T radians: the pieces tile it exactly, and the battery's quadrature must see the
@@ -752,7 +765,7 @@ template <class T> struct SphereProjectedCapPolar : SphereProjectedCap<T> {
   }
   static T pdf(const View& v, const Vec3<T>& w) { return pdf_projected_spherical_cap_polar(v, w); }
   static bool invert(const View& v, const Vec3<T>& w, Vec2<T>& u) {
-    return pdf_projected_spherical_cap_polar(v, w, &u) > T(0);
+    return invert_projected_spherical_cap_polar(v, w, u);
   }
   // Case 1: none (the polar map is smooth for u0 > 0, and u1's seam is periodic); Cases 2-3: the quintic's.
   static std::vector<T> kinks_u0(const SphereLightGeometry<T>& g) {
