@@ -163,8 +163,9 @@ template <class T> ProjectedCapCase<T> decode_projected_cap_case(FuzzedDataProvi
 // integrand at the boundary) and |dP/dt| <= the cap's solid angle 2 pi (1 - cos) (rotating the cap by dt changes
 // n.w by at most dt on it). Hence, with the quadrature's own error estimate,
 //   rel = kTolUlps eps kappa (tan(theta) sin(theta) I(theta) + 2 pi (1 - cos theta)) / P + 16 eps + 16 err / P.
-template <class T, CutDiskInverse M>
-void check_projected_cap_normaliser(const ProjectedCapCase<T>& c, const Mutation& mutate) {
+template <class K>
+void check_projected_cap_normaliser(const ProjectedCapCase<typename K::Scalar>& c, const Mutation& mutate) {
+  using T = typename K::Scalar;
   const ProjectedCapView<T>& view = c.view;
   const ProjectedCapReference& ref = c.ref;
   if (!(view.valid() && ref.defined && view.which_case <= 2)) return;
@@ -174,8 +175,8 @@ void check_projected_cap_normaliser(const ProjectedCapCase<T>& c, const Mutation
       std::tan(th) * std::sin(th) * ring_cosine_integral(th, ref.t) + kTwoPi<L> * 2 * std::pow(std::sin(th / 2), 2);
   const L rel =
       q.value > 0 ? (L(kTolUlps) * eps<T>() * c.sref.kappa * sens + 16 * q.error) / q.value + 16 * eps<T>() : L(1);
-  const std::string geo = describe(c.g, Vec2<T>(Vec2<T>::Zero()), SphereProjectedCapKernel<T, M>::name) +
-                          "view, case " + std::to_string(view.which_case) + "\n";
+  const std::string geo =
+      describe(c.g, Vec2<T>(Vec2<T>::Zero()), K::name) + "view, case " + std::to_string(view.which_case) + "\n";
   const L total = L(mutate.normaliser(view.total));
   if (rel < L(0.5))
     WARPCHECK_FUZZ_REQUIRE(std::abs(total / q.value - 1) <= rel, "A_E + A_D differs from the projected solid angle",
@@ -202,21 +203,18 @@ ProjectedCapDraws<T> decode_projected_cap_draws(FuzzedDataProvider& in, const Pr
 
 // One inverse's samples and densities (header comment's invariants). The pdf comparison is probed
 // (check_pdf_consistency_probed): the warp's pieces and the quintic's fold make the density piecewise smooth.
-// Polar: sphere-projected-cap-polar (Case 1 by polar coordinates, M the quintic).
-template <class T, CutDiskInverse M, bool Polar = false>
-void check_projected_cap_kernel(const ProjectedCapCase<T>& c, const ProjectedCapDraws<T>& draws,
-                                const Mutation& mutate) {
-  const char* name = Polar ? SphereProjectedCapPolar<T>::name : SphereProjectedCapKernel<T, M>::name;
+template <class K> void check_projected_cap_kernel(const ProjectedCapCase<typename K::Scalar>& c,
+                                                   const ProjectedCapDraws<typename K::Scalar>& draws,
+                                                   const Mutation& mutate) {
+  using T = typename K::Scalar;
+  const char* name = K::name;
   const ProjectedCapView<T>& view = c.view;
   const ProjectedCapTolerances<T> tols(c.ref, view.which_case);
   const L e = tols.e;
-  auto pdf = [&](const Vec3<T>& w) {
-    return mutate.pdf(Polar ? pdf_projected_spherical_cap_polar(view, w) : pdf_projected_spherical_cap<T, M>(view, w));
-  };
+  auto pdf = [&](const Vec3<T>& w) { return mutate.pdf(K::pdf(view, w)); };
   for (int k = 0; k < draws.samples; ++k) {
     const Vec2<T> u = draws.u[k];
-    const DirectionSample<T> s = mutate.sample(Polar ? sample_projected_spherical_cap_polar(view, u)
-                                                     : sample_projected_spherical_cap<T, M>(view, u));
+    const DirectionSample<T> s = mutate.sample(K::sample(view, u));
     const std::string geo = describe(c.g, u, name) + "case " + std::to_string(view.which_case) + "\n";
     check_sample_shape(s, geo);
     if (!c.finite_input) WARPCHECK_FUZZ_REQUIRE(!s.valid(), "a sample from non-finite input", geo);
@@ -251,14 +249,15 @@ void check_projected_cap_kernel(const ProjectedCapCase<T>& c, const ProjectedCap
 // The target of one inverse: the view's normaliser, then the inverse's samples and densities. An input holds the
 // draws of the quintic, then those of the exact inverse (one target checked both before they were split, and the
 // stored inputs decode as they did); each target checks its own.
-// sphere-projected-cap-polar decodes as the quintic's target (its corpus seeded from that one's).
-template <class T, CutDiskInverse M, bool Polar = false>
-void check_projected_cap(FuzzedDataProvider& in, const Mutation& mutate = {}) {
+// K is one of the projected-cap kernel traits; sphere-projected-cap-polar (the quintic's inverse) decodes as the
+// quintic's target (its corpus seeded from that one's).
+template <class K> void check_projected_cap(FuzzedDataProvider& in, const Mutation& mutate = {}) {
+  using T = typename K::Scalar;
   const ProjectedCapCase<T> c = decode_projected_cap_case<T>(in);
-  check_projected_cap_normaliser<T, M>(c, mutate);
+  check_projected_cap_normaliser<K>(c, mutate);
   ProjectedCapDraws<T> draws = decode_projected_cap_draws(in, c.view);
-  if (M == CutDiskInverse::kExact) draws = decode_projected_cap_draws(in, c.view);
-  check_projected_cap_kernel<T, M, Polar>(c, draws, mutate);
+  if (K::inverse == CutDiskInverse::kExact) draws = decode_projected_cap_draws(in, c.view);
+  check_projected_cap_kernel<K>(c, draws, mutate);
 }
 
 }  // namespace warpcheck::fuzz

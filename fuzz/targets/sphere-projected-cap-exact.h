@@ -9,7 +9,7 @@ namespace warpcheck::fuzz {
 
 template <> struct FuzzTarget<SphereProjectedCapExact> {
   template <class T> static void check(FuzzedDataProvider& in, const Mutation& mutate = {}) {
-    check_projected_cap<T, CutDiskInverse::kExact>(in, mutate);
+    check_projected_cap<SphereProjectedCapExact<T>>(in, mutate);
   }
 };
 

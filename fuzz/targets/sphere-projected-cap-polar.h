@@ -9,7 +9,7 @@ namespace warpcheck::fuzz {
 
 template <> struct FuzzTarget<SphereProjectedCapPolar> {
   template <class T> static void check(FuzzedDataProvider& in, const Mutation& mutate = {}) {
-    check_projected_cap<T, CutDiskInverse::kQuintic, true>(in, mutate);
+    check_projected_cap<SphereProjectedCapPolar<T>>(in, mutate);
   }
 };
 

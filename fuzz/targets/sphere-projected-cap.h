@@ -8,7 +8,7 @@ namespace warpcheck::fuzz {
 
 template <> struct FuzzTarget<SphereProjectedCap> {
   template <class T> static void check(FuzzedDataProvider& in, const Mutation& mutate = {}) {
-    check_projected_cap<T, CutDiskInverse::kQuintic>(in, mutate);
+    check_projected_cap<SphereProjectedCap<T>>(in, mutate);
   }
 };
 

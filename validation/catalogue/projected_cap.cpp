@@ -142,8 +142,10 @@ template <CutDiskInverse M> std::vector<std::pair<Real, Real>> projected_cap_ban
 //   m1_in  = E[X 1(w in the light)]   (what a renderer computes: a ray outside the cap misses the light)
 //   m2     = E[X^2]
 // (m1 alone with mean_only.)
-template <class T, CutDiskInverse M, bool Polar>
+template <class K>
 LambertianMoments projected_cap_lambertian_moments(const SphereLightGeometry<Real>& g, Real tol, bool mean_only) {
+  using T = typename K::Scalar;
+  constexpr CutDiskInverse M = K::inverse;
   // min_complement 1e-18: no abscissa closer than that to an end of [0, 1]. Boost's default (4 * min of long
   // double) puts u0 within ~1e-4900 of a piece's end, where it rounds onto the end itself (a sample on the
   // silhouette, declined, or on the next piece); for the exact inverse in long double on tiny-straddling that
@@ -171,9 +173,7 @@ LambertianMoments projected_cap_lambertian_moments(const SphereLightGeometry<Rea
       auto inner = [&](Real u0) {
         return ts.integrate(
             [&](Real u1) {
-              const Vec2<T> u = Vec2<T>(T(u0), T(u1));
-              const auto s =
-                  Polar ? sample_projected_spherical_cap_polar(p, u) : sample_projected_spherical_cap<T, M>(p, u);
+              const auto s = K::sample(p, Vec2<T>(T(u0), T(u1)));
               if (!s.valid()) return Real(0);
               const Vec3L w = to_long(s.direction);
               if (what == 1 && (w - light.axis).squaredNorm() > 2 * light.one_minus_cos * (1 + in_slack))
@@ -198,8 +198,6 @@ namespace {
 template <class T> Real moments_tolerance() { return std::max<Real>(1e-10L, std::numeric_limits<T>::epsilon()); }
 
 template <template <class> class K, class T> Case make_case(const ProjectedCapConfig& c) {
-  constexpr CutDiskInverse M = K<T>::inverse;
-  constexpr bool polar = std::is_same_v<K<T>, SphereProjectedCapPolar<T>>;
   const char* kernel = K<T>::name;
   Case k;
   k.kernel = kernel;
@@ -231,9 +229,7 @@ template <template <class> class K, class T> Case make_case(const ProjectedCapCo
     }
     Normalization mean;
     mean.what = "mean Lambertian estimate E[cos/pdf] (primary-space quadrature) vs projected solid angle";
-    mean.kernel = [g = c.g] {
-      return projected_cap_lambertian_moments<T, M, polar>(g, moments_tolerance<T>(), true).m1;
-    };
+    mean.kernel = [g = c.g] { return projected_cap_lambertian_moments<K<T>>(g, moments_tolerance<T>(), true).m1; };
     mean.reference = reference;
     s.normalizations.push_back(mean);
     if constexpr (std::is_same_v<T, float>) {
@@ -250,7 +246,7 @@ template <template <class> class K, class T> Case make_case(const ProjectedCapCo
     const SphereView<Real> sv = make_sphere_view(c.g);
     if (!sv.valid()) return out;
     const Real phi = reference_projected_solid_angle(c.g);
-    const LambertianMoments m = projected_cap_lambertian_moments<T, M, polar>(c.g, moments_tolerance<T>());
+    const LambertianMoments m = projected_cap_lambertian_moments<K<T>>(c.g, moments_tolerance<T>());
     // Solid-angle sampling: the estimate is Omega max(0, cos): E = Phi, E[X^2] = Omega * integral of cos_+^2.
     const Real omega = kTwoPi<Real> * sv.one_minus_cos_max;
     const Real cos2 = cap_cosine_moment(c.g, 2);
@@ -293,23 +289,9 @@ template <template <class> class K, class T> Case make_case(const ProjectedCapCo
 
 }  // namespace
 
-template LambertianMoments projected_cap_lambertian_moments<float, CutDiskInverse::kQuintic>(
+template LambertianMoments projected_cap_lambertian_moments<SphereProjectedCap<double>>(
     const SphereLightGeometry<Real>&, Real, bool);
-template LambertianMoments projected_cap_lambertian_moments<double, CutDiskInverse::kQuintic>(
-    const SphereLightGeometry<Real>&, Real, bool);
-template LambertianMoments projected_cap_lambertian_moments<Real, CutDiskInverse::kQuintic>(
-    const SphereLightGeometry<Real>&, Real, bool);
-template LambertianMoments projected_cap_lambertian_moments<float, CutDiskInverse::kExact>(
-    const SphereLightGeometry<Real>&, Real, bool);
-template LambertianMoments projected_cap_lambertian_moments<double, CutDiskInverse::kExact>(
-    const SphereLightGeometry<Real>&, Real, bool);
-template LambertianMoments projected_cap_lambertian_moments<Real, CutDiskInverse::kExact>(
-    const SphereLightGeometry<Real>&, Real, bool);
-template LambertianMoments projected_cap_lambertian_moments<float, CutDiskInverse::kQuintic, true>(
-    const SphereLightGeometry<Real>&, Real, bool);
-template LambertianMoments projected_cap_lambertian_moments<double, CutDiskInverse::kQuintic, true>(
-    const SphereLightGeometry<Real>&, Real, bool);
-template LambertianMoments projected_cap_lambertian_moments<Real, CutDiskInverse::kQuintic, true>(
+template LambertianMoments projected_cap_lambertian_moments<SphereProjectedCapExact<double>>(
     const SphereLightGeometry<Real>&, Real, bool);
 template std::vector<std::pair<Real, Real>> projected_cap_bands<CutDiskInverse::kQuintic>(
     const SphereLightGeometry<Real>&);

@@ -31,16 +31,15 @@ template <CutDiskInverse M> std::vector<std::pair<Real, Real>> projected_cap_ban
 // cap's axis in closed form and long double Gauss-Kronrod across the rings.
 Real cap_cosine_moment(const SphereLightGeometry<Real>& g, int power);
 
-// Moments of the Lambertian irradiance estimator X = cos / pdf (unit radiance) of the kernel in T with cut-disk
-// inverse M (Polar: with Case 1 by polar coordinates, sphere-projected-cap-polar), over primary sample space by
-// nested tanh-sinh quadrature in long double (deterministic): m1 = E[X], m1_in = E[X; the ray hits the light],
-// m2 = E[X^2].
+// Moments of the Lambertian irradiance estimator X = cos / pdf (unit radiance) of projected-cap kernel K (a
+// catalogue trait, e.g. SphereProjectedCap<double>), over primary sample space by nested tanh-sinh quadrature in
+// long double (deterministic): m1 = E[X], m1_in = E[X; the ray hits the light], m2 = E[X^2]. (make_case instantiates it
+// for the registry's kernels; the quintic and exact kernels in double are instantiated for the tests and tools.)
 struct LambertianMoments {
   Real m1 = 0, m1_in = 0, m2 = 0;
 };
-template <class T, CutDiskInverse M, bool Polar = false>
-LambertianMoments projected_cap_lambertian_moments(const SphereLightGeometry<Real>& g, Real tol = 1e-10L,
-                                                   bool mean_only = false);
+template <class K> LambertianMoments projected_cap_lambertian_moments(const SphereLightGeometry<Real>& g,
+                                                                      Real tol = 1e-10L, bool mean_only = false);
 
 // float's tolerance for a configuration: twice its measured float error (the largest deterministic battery
 // statistic of the float kernels, see projected_cap.cpp), rounded up to one digit, at least 1e-6.

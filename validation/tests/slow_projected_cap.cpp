@@ -26,8 +26,8 @@ TEST(ProjectedCapLambertian, EstimateIsUnbiasedInCase3ForBothInverses) {
   for (const char* name : {"case3", "case3-fig9"}) {
     const ProjectedCapConfig c = config(name);
     const Real phi = reference_projected_solid_angle(c.g);
-    const LambertianMoments q = projected_cap_lambertian_moments<double, CutDiskInverse::kQuintic>(c.g, 1e-9L);
-    const LambertianMoments e = projected_cap_lambertian_moments<double, CutDiskInverse::kExact>(c.g, 1e-9L);
+    const LambertianMoments q = projected_cap_lambertian_moments<SphereProjectedCap<double>>(c.g, 1e-9L);
+    const LambertianMoments e = projected_cap_lambertian_moments<SphereProjectedCapExact<double>>(c.g, 1e-9L);
     EXPECT_LT(std::abs(q.m1_in / phi - 1), 1e-7L) << name;
     EXPECT_LT(std::abs(e.m1_in / phi - 1), 1e-7L) << name;
     EXPECT_GT(e.m2 / (e.m1 * e.m1) - 1, 1e-4L) << name;  // Case 3 is not zero-variance (bounded deviation)

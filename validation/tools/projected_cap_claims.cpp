@@ -90,8 +90,8 @@ std::string configuration_claims() {
     if (!v.valid()) continue;
     const Real d = round_trip_u0_deviation(c.g, 100000);
     const Real phi = reference_projected_solid_angle(c.g);
-    const LambertianMoments mq = projected_cap_lambertian_moments<double, CutDiskInverse::kQuintic>(c.g, 1e-10L);
-    const LambertianMoments me = projected_cap_lambertian_moments<double, CutDiskInverse::kExact>(c.g, 1e-10L);
+    const LambertianMoments mq = projected_cap_lambertian_moments<SphereProjectedCap<double>>(c.g, 1e-10L);
+    const LambertianMoments me = projected_cap_lambertian_moments<SphereProjectedCapExact<double>>(c.g, 1e-10L);
     const SphereView<Real> sv = make_sphere_view(c.g);
     const Real omega = kTwoPi<Real> * sv.one_minus_cos_max;
     const Real var_sa = omega * cap_cosine_moment(c.g, 2) / (phi * phi) - 1;
