@@ -248,13 +248,14 @@ template <Kernel K> SamplerUnderTest bind_kernel(std::string config, const typen
   s.kernel = K::name;
   s.config = std::move(config);
   s.scalar = scalar_name<T>();
-  s.sample = [v = K::view(g)](double u0, double u1) {
-    return to_sample(K::sample(v, Vec2<T>(to_unit<T>(u0), to_unit<T>(u1))));
+  // K's sample at a uniform pair in double, the form every entry point below draws through.
+  static constexpr auto draw = [](const typename K::View& v, double u0, double u1) {
+    return K::sample(v, Vec2<T>(to_unit<T>(u0), to_unit<T>(u1)));
   };
+  s.sample = [v = K::view(g)](double u0, double u1) { return to_sample(draw(v, u0, u1)); };
   s.pdf = [v = K::view(g)](const Vec3L& w) { return Real(K::pdf(v, w.template cast<T>())); };
   s.sample_block = [v = K::view(g)](std::span<const double> u0, std::span<const double> u1, std::span<Sample> out) {
-    for (std::size_t i = 0; i < out.size(); ++i)
-      out[i] = to_sample(K::sample(v, Vec2<T>(to_unit<T>(u0[i]), to_unit<T>(u1[i]))));
+    for (std::size_t i = 0; i < out.size(); ++i) out[i] = to_sample(draw(v, u0[i], u1[i]));
   };
   s.pdf_block = [v = K::view(g)](std::span<const Vec3L> w, std::span<Real> out) {
     for (std::size_t i = 0; i < out.size(); ++i) out[i] = Real(K::pdf(v, w[i].template cast<T>()));
@@ -263,7 +264,7 @@ template <Kernel K> SamplerUnderTest bind_kernel(std::string config, const typen
     s.sample_block_double = [v = K::view(g)](std::span<const double> u0, std::span<const double> u1,
                                              DoubleSamples out) {
       for (std::size_t i = 0; i < out.x.size(); ++i) {
-        const DirectionSample<T> x = K::sample(v, Vec2<T>(to_unit<T>(u0[i]), to_unit<T>(u1[i])));
+        const DirectionSample<T> x = draw(v, u0[i], u1[i]);
         out.x[i] = x.direction.x(), out.y[i] = x.direction.y(), out.z[i] = x.direction.z();
         out.pdf[i] = x.pdf, out.valid[i] = x.valid();
       }
