@@ -307,6 +307,12 @@ TEST(Battery, RefusesABlockFormThatDisagreesWithTheReplacedSingleForm) {
   s.sample = [sample](double u0, double u1) { return sample(u1, u0); };
   EXPECT_NE(invalid_argument_of(s).find("sample_block disagrees with sample"), std::string::npos)
       << invalid_argument_of(s);
+  s.sample_block = nullptr;  // the double block form is still the old kernel's
+  ASSERT_TRUE(s.sample_block_double);
+  EXPECT_NE(invalid_argument_of(s).find("sample_block_double disagrees with sample"), std::string::npos)
+      << invalid_argument_of(s);
+  s.sample_block_double = nullptr;
+  EXPECT_NO_THROW(battery::check_block_forms(s));
 }
 
 TEST(Battery, EveryRegisteredCasesBlockFormsAgreeWithItsSingleForms) {
