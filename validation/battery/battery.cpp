@@ -48,7 +48,7 @@ BatteryOptions checked_options(const SamplerUnderTest& s, const BatteryOptions& 
 // beside the grid quadrature and the draws, which use every thread.
 struct Prepared {
   Expected expected;
-  std::shared_future<Real> outside;                         // the pdf's integral outside the bounding cap
+  std::shared_future<Real> outside;                         // the pdf's integral beyond the cap and its rim
   std::shared_future<std::vector<TestResult>> independent;  // pdf-consistency, normalisations, weight, round-trip
 };
 

@@ -44,6 +44,10 @@ Real scalar_epsilon(const std::string& scalar) {
   return DBL_EPSILON;
 }
 
+Real rounding_slack(const SamplerUnderTest& s) {
+  return 64 * scalar_epsilon(s.scalar) * (1 + std::sqrt(2 / s.bounding_cap.one_minus_cos));
+}
+
 Sample draw_one(const SamplerUnderTest& s, Rng& g, std::vector<double>& u) {
   u.resize(std::size_t(s.uniforms));
   for (double& x : u) x = uniform01(g);
@@ -136,10 +140,9 @@ CapBinner::CapBinner(const SamplerUnderTest& s, const BatteryOptions& o, const s
       columns_(o.azimuth_bins),
       radial_(ks_radial_nodes),
       azimuth_(ks_azimuth_nodes) {
-  // A sample may land a rounding error beyond the cap's edge: t's error is about eps * sqrt(2 / omc) (the
-  // angle's error over the cap's angular radius). Within that slack it counts in the outermost ring.
+  // A sample may land a rounding error beyond the cap's edge; within rounding_slack it counts in the outermost ring.
   const Real omc = cap_.one_minus_cos;
-  slack_ = 64 * scalar_epsilon(s.scalar) * (1 + std::sqrt(2 / omc));
+  slack_ = rounding_slack(s);
   const Frame<Real> f = Frame<Real>::from_z(cap_.axis);
   for (int i = 0; i < 3; ++i) axis_[i] = double(cap_.axis[i]), fx_[i] = double(f.x[i]), fy_[i] = double(f.y[i]);
   half_over_omc_ = double(1 / (2 * omc));

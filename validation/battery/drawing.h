@@ -37,6 +37,11 @@ template <class G> double uniform01(G& g) { return double(g() >> 11) * 0x1.0p-53
 // The machine epsilon of a sampler's scalar type ("float", "double", "long double"; others as double).
 Real scalar_epsilon(const std::string& scalar);
 
+// How far beyond the bounding cap's edge, in t = (1 - cos theta) / (1 - cos theta_max), a sample still counts in the
+// outermost ring, and the resolution in t of the expected counts: a direction in the sampler's scalar type has an
+// angular error of a few epsilon, which over the cap's angular radius (about sqrt(2 omc)) is eps sqrt(2 / omc) in t.
+Real rounding_slack(const SamplerUnderTest& s);
+
 // One sample of the sampler from the next s.uniforms numbers of g (u holds them afterwards).
 Sample draw_one(const SamplerUnderTest& s, Rng& g, std::vector<double>& u);
 

@@ -42,14 +42,19 @@ Real ks_cdf_tolerance(std::uint64_t n);
 // [radial][azimuth]) and the KS CDFs. By the grid quadrature (cap_grid.h) when the difference of its two orders of
 // integration, taken as its error, is within the bounds above and leaves the pdf-integral test's decision alone,
 // or for a float pdf, whose rounding no quadrature integrates better (the details then state the difference); else by
-// reference_bin_masses and reference_ks_cdfs (or by those alone with options.reference_quadrature).
+// reference_bin_masses and reference_ks_cdfs (or by those alone with options.reference_quadrature). Both with the
+// rim's mass (Expected::rim) in the last ring.
 struct Expected {
   std::vector<Real> mass;
   KsCdfs ks;
   std::string quadrature;  // which quadrature, and why, for the tests' details
   Real inside_error = 0;   // the grid's two estimates of the integral over the cap differ by this
+  Real rim = 0;            // mass beyond the cap's edge where samples still count in the last ring (rounding_slack)
 };
 Expected expected_integrals(const SamplerUnderTest& s, const BatteryOptions& o);
+// Adds the pdf's mass in the rim 1 < t <= 1 + rounding_slack beyond the cap's edge, where drawing counts samples in
+// the outermost ring, to e's last ring and both KS CDFs, and sets e.rim (expected_integrals does).
+void add_rim(const SamplerUnderTest& s, const BatteryOptions& o, Expected& e);
 // The nested adaptive quadrature of each bin and of each KS slab (integrate_cap_region), to tolerance
 // options.quadrature_tolerance: slow, and what the grid is tested against.
 std::vector<Real> reference_bin_masses(const SamplerUnderTest& s, const BatteryOptions& o);
@@ -80,7 +85,7 @@ void ks_tests(const SamplerUnderTest& s, const KsCdfs& c, const Draws& d, std::v
 
 // ---- Deterministic (deterministic_tests.cpp) -----------------------------------------------------------------
 
-// The pdf's integral over the sphere outside the bounding cap (nested adaptive quadrature).
+// The pdf's integral over the sphere beyond the bounding cap and its rim (nested adaptive quadrature).
 Real outside_integral(const SamplerUnderTest& s, const BatteryOptions& o);
 TestResult pdf_integral(const SamplerUnderTest& s, const BatteryOptions& o, const Expected& e, Real outside);
 TestResult pdf_consistency(const SamplerUnderTest& s, const BatteryOptions& o);

@@ -120,11 +120,11 @@ template <template <class> class K, class T> void add_case(Registry& r, const Sp
     s.expect_no_sample = !valid;
     if (valid) s.normalizations.push_back(normalization<K, T>(c));
     if constexpr (std::is_same_v<T, float>) {
-      // Measured, not derived: at 1e7 samples (seed 1) the float solid-angle kernel's pdf integrates to 1 - 5.2e-6 on
-      // "tiny" (cap half-angle 2e-3 rad, 1 - cos = 2e-6, a few float ulps of 1); the others stay below 1e-6. The
-      // battery's quadrature itself runs at 16 FLT_EPSILON = 1.9e-6 for float samplers (battery.cpp).
-      s.tolerance = 1e-5L;
-      s.tolerance_note = "float: measured pdf-integral error up to 5.2e-6 (tiny cap, 1 - cos(theta_max) = 2e-6)";
+      // Twice the largest deterministic statistic of either float kernel's valid configurations outside its
+      // known limitation, rounded up: solid angle 6.7e-7 (pdf-integral, near-touching: 1 - cos(theta_max) from
+      // r / d = 0.999), measured with `warpcheck validate --kernel 'sphere-*' --scalar float` (1e7 samples, seed 1).
+      s.tolerance = 2e-6L;
+      s.tolerance_note = "float: twice the measured largest error, 6.7e-7 (pdf-integral, near-touching)";
     }
     return s;
   };

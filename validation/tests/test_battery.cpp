@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <functional>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include <Eigen/LU>
@@ -216,6 +217,29 @@ const TestResult& find_test(const std::vector<TestResult>& r, const std::string&
   throw std::runtime_error("no result " + name);
 }
 
+// A float sampler may put samples up to battery::rounding_slack beyond its bounding cap's edge, where they count in
+// the outermost ring; the pdf's mass there must count as well. A cone half a slack wider than its declared bounding
+// cap (5.4e-4 of its mass, 540 samples at 1e6, in the rim): without the rim's mass the chi-square aggregates expect
+// 540 samples outside and see none (chi2-rings about 16 + 540), and pdf-integral misses 5.4e-4.
+TEST(Battery, CountsThePdfsMassInTheRimBeyondTheBoundingCapWhereItsSamplesCount) {
+  SamplerUnderTest s;
+  s.kernel = "wider-cone", s.scalar = "float", s.config = "test";
+  s.bounding_cap = Cap<Real>{Vec3L(0, 0, 1), Real(1e-4)};
+  const Real rim = battery::rounding_slack(s), widened = 1 + rim / 2;
+  const Cap<Real> cone{s.bounding_cap.axis, s.bounding_cap.one_minus_cos * widened};
+  ASSERT_GT(rim / 2 / widened, 5e-4);
+  const Real density = 1 / cone.solid_angle();
+  s.sample = [cone, density](double u0, double u1) {
+    return Sample{cap_direction(cone, Real(u0), kTwoPi<Real> * Real(u1)), density, true};
+  };
+  s.pdf = [cone, density](const Vec3L& w) { return cone.contains(w, 1e-15L) ? density : Real(0); };
+  BatteryOptions o;
+  o.samples = 1'000'000;
+  const auto r = validate(s, o);
+  EXPECT_TRUE(all_passed(r)) << format_table(r);
+  EXPECT_LT(find_test(r, "pdf-integral").statistic, 1e-6) << find_test(r, "pdf-integral").detail;
+}
+
 // pdf-consistency's resolution check: a reference warp whose directions carry rounding-like noise of 1e-10 rad
 // (a deterministic hash of u) cannot resolve its own area element at h ~ 1e-4 (noise / h ~ 1e-6 relative, four
 // times the tolerance / 4); those points are counted as unresolved, and with most of them unresolved the test
@@ -313,6 +337,26 @@ TEST(Battery, RefusesABlockFormThatDisagreesWithTheReplacedSingleForm) {
       << invalid_argument_of(s);
   s.sample_block_double = nullptr;
   EXPECT_NO_THROW(battery::check_block_forms(s));
+}
+
+// The pdf-integral of float cases whose edges are rounded: the 2e-3 rad sphere, whose float pdf is 0 on a band
+// inside its edge and positive on one beyond it (5.3e-6 of its mass each; Battery.CountsThePdfsMassInTheRim...),
+// and the square seen 0.3 deg from its plane, whose float edges are those of its rounded vertices, off the exact
+// ones (the grid splits at the float polygon's edges). Missing either mass reads 1 - 5e-6 or lower.
+TEST(Battery, IntegratesAFloatPdfToOneAcrossItsRoundedEdges) {
+  const Registry reg = default_registry();
+  BatteryOptions o;
+  o.samples = 1000;
+  for (const auto& [kernel, config] : {std::pair{"sphere-solid-angle", "tiny"},
+                                       {"sphere-projected-cap", "tiny"},
+                                       {"baseline-turk-area", "nearly-edge-on"}}) {
+    const Case* c = nullptr;
+    for (const Case& x : reg.cases())
+      if (x.kernel == kernel && x.scalar == "float" && x.config == config) c = &x;
+    ASSERT_TRUE(c) << kernel;
+    const TestResult& r = find_test(run_battery(c->make(), o), "pdf-integral");
+    EXPECT_LT(r.statistic, 3e-7) << kernel << " " << r.detail;
+  }
 }
 
 TEST(Battery, EveryRegisteredCasesBlockFormsAgreeWithItsSingleForms) {

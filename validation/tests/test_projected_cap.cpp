@@ -374,9 +374,10 @@ TEST(ProjectedCapFloat, SamplePdfsNearTheHorizonKeepTheirDigits) {
   EXPECT_GT(worst_naive, 1e4 * eps);  // the check sees the naive lift's error
 }
 
-// The float known limitation on "tiny" (projected_cap.cpp): on a light of 2e-3 rad, float's directions are 3e-5 of
-// its radius apart, so its edge is rounded that coarsely and a few samples land where the float pdf is 0 (27 and
-// 30 in 1e6, quintic and exact inverse), the mass the chi-square aggregates then miss. In double none does.
+// Float on "tiny": on a light of 2e-3 rad, float's directions are 3e-5 of its radius apart, so its edge is rounded
+// that coarsely and a few samples land where the float pdf is 0 (27 and 30 in 1e6, quintic and exact inverse),
+// balanced by a band just beyond the edge where it is positive (the rim the battery integrates:
+// docs/derivations/battery-quadrature.md). In double none does.
 template <class T> SphereLightGeometry<T> rounded_to(const SphereLightGeometry<Real>& g) {
   return {ShadingPoint<T>{g.shading.position.cast<T>(), g.shading.normal.cast<T>()},
           SphereLight<T>{g.light.center.cast<T>(), T(g.light.radius)}};

@@ -4,7 +4,8 @@
 //   chi2          chi-square on an equal-area grid over the sampler's bounding cap; expected counts from
 //                 long double adaptive quadrature of the pdf; low-expected bins pooled; p from
 //                 boost::math::chi_squared. A sample outside the bounding cap, or declined, where the pdf
-//                 gives no mass is impossible under the null hypothesis: p = 0.
+//                 gives no mass is impossible under the null hypothesis: p = 0. A sample a rounding error beyond
+//                 the cap's edge counts in the outermost ring, and so does the pdf's mass there.
 //   chi2-rings, chi2-columns, chi2-coarse  the same counts and expected counts summed over the grid's rings, its
 //                 columns and a 4 x 8 coarse grid, with the same outside cell and pooling: a coherent error (a ring
 //                 or wedge too dense, a smooth tilt) adds up in few cells instead of spreading over 511 dof

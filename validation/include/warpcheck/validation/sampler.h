@@ -280,7 +280,10 @@ template <Kernel K> SamplerUnderTest bind_kernel(std::string config, const typen
 }
 
 // As above, with KRef (the same kernel in long double, on the same geometry converted) as the reference warp;
-// the bounding cap, the kinks and the boundary planes and caps come from KRef.
+// the bounding cap and the kinks come from KRef. The boundary planes and caps, where the pdf jumps, are KRef's on
+// K's own geometry (g, exactly converted, where the geometry converts): a float polygon's edges are those of its
+// rounded vertices, up to 1e-7 rad off the exact ones, and a quadrature split at the exact edges integrates across
+// the rounded ones.
 template <Kernel K, Kernel KRef>
 SamplerUnderTest bind_kernel(std::string config, const typename K::Geometry& g, const typename KRef::Geometry& g_ref) {
   SamplerUnderTest s = bind_kernel<K>(std::move(config), g);
@@ -293,8 +296,11 @@ SamplerUnderTest bind_kernel(std::string config, const typename K::Geometry& g, 
   s.bounding_cap = Cap<Real>{to_long(cap.axis).normalized(), Real(cap.one_minus_cos)};
   s.kinks_u0 = kernel_kinks<KRef>(g_ref, 0);
   s.kinks_u1 = kernel_kinks<KRef>(g_ref, 1);
-  s.boundary_planes = kernel_boundary_planes<KRef>(g_ref);
-  s.boundary_caps = kernel_boundary_caps<KRef>(g_ref);
+  const typename KRef::Geometry* own = &g_ref;
+  typename KRef::Geometry converted;
+  if constexpr (requires { g.template cast<R>(); }) own = &(converted = g.template cast<R>());
+  s.boundary_planes = kernel_boundary_planes<KRef>(*own);
+  s.boundary_caps = kernel_boundary_caps<KRef>(*own);
   return s;
 }
 
