@@ -81,6 +81,20 @@ template <class T> Vec3<T> kahan_cross(const Vec3<T>& a, const Vec3<T>& b) {
 // z component of a x b for 2D vectors, by Kahan.
 template <class T> T kahan_cross2(const Vec2<T>& a, const Vec2<T>& b) { return kahan_det(a.x(), a.y(), b.x(), b.y()); }
 
+// The sign of a d - b c (-1, 0 or 1), always kahan_det's. The plainly rounded difference decides where it exceeds
+// its rounding error, about eps (|a d| + |b c|) plus the least subnormal, so below 4 eps (|a d| + |b c|) once that
+// sum is normal (a floating-point filter, as in Shewchuk 1997's orientation tests); there kahan_det's sign is the
+// exact one too. Elsewhere (near-singular, subnormal, Inf, NaN) kahan_det decides: its FMAs are library calls, or in
+// x87 long double an emulation, several times the cost of the filter.
+template <class T> int det_sign(T a, T b, T c, T d) {
+  const T ad = a * d, bc = b * c, det = ad - bc, scale = std::abs(ad) + std::abs(bc);
+  if (scale >= std::numeric_limits<T>::min() && std::abs(det) > T(4) * std::numeric_limits<T>::epsilon() * scale)
+    return det > T(0) ? 1 : -1;
+  const T k = kahan_det(a, b, c, d);
+  return (k > T(0)) - (k < T(0));
+}
+template <class T> int cross2_sign(const Vec2<T>& a, const Vec2<T>& b) { return det_sign(a.x(), a.y(), b.x(), b.y()); }
+
 // Normalises without overflow or underflow (scales by the largest entry first); zero stays zero.
 template <class T> Vec3<T> safe_normalized(const Vec3<T>& v) {
   const T m = v.cwiseAbs().maxCoeff();

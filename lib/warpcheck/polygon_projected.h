@@ -236,8 +236,8 @@ Vec2<T> decentral_iteration(const ProjectedSector<T>& s, T target, T rest, const
 
 // Puts w back on the sector's nearer boundary (where the ellipses coincide, Eq. 5's root can leave the sector).
 template <class T> Vec2<T> clamp_to_sector(const ProjectedSector<T>& s, const Vec2<T>& w) {
-  if (kahan_cross2(s.s0, w) < T(0)) return l1_normalized(s.s0);
-  if (kahan_cross2(w, s.s1) < T(0)) return l1_normalized(s.s1);
+  if (cross2_sign(s.s0, w) < 0) return l1_normalized(s.s0);
+  if (cross2_sign(w, s.s1) < 0) return l1_normalized(s.s1);
   return w;
 }
 
@@ -546,7 +546,7 @@ bool invert_polygon_projected_solid_angle(const PolygonProjectedView<T>& v, cons
     const ProjectedSector<T>& s = v.sectors[k];
     if (!(s.area > T(0))) continue;
     const bool last = k == v.sector_count - 1;
-    if (kahan_cross2(s.s0, wxy) < T(0) || (!last && kahan_cross2(wxy, s.s1) < T(0))) {
+    if (cross2_sign(s.s0, wxy) < 0 || (!last && cross2_sign(wxy, s.s1) < 0)) {
       before += s.area;
       continue;
     }

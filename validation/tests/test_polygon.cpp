@@ -6,7 +6,9 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdio>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -284,6 +286,59 @@ TEST(PolygonNumerics, KahanCrossIsAccurateForShortEdgesFarAway) {
   std::printf("[ float ] worst relative error of edge normals: Kahan %.2e, plain %.2e\n", worst_kahan, worst_plain);
   EXPECT_LE(worst_kahan, 4 * std::numeric_limits<float>::epsilon());
   EXPECT_GT(worst_plain, 100 * worst_kahan);  // the remedy is needed: the plain cross product cancels
+}
+
+// det_sign's filter never decides differently from kahan_det: on random, nearly singular (a d and b c equal to within
+// a few ulps, both sides of the filter's threshold), subnormal, overflowing and non-finite inputs. Float's sign is
+// also checked against the exact one where the products and the determinant are normal floats (float products are
+// exact in double, and rounding keeps a difference's sign; kahan_det loses it to underflow and overflow).
+template <class T> void expect_det_sign_is_kahan_dets_sign(const char* name) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> U(-1, 1);
+  const T eps = std::numeric_limits<T>::epsilon();
+  const T specials[] = {T(0),
+                        -T(0),
+                        std::numeric_limits<T>::infinity(),
+                        std::numeric_limits<T>::quiet_NaN(),
+                        std::numeric_limits<T>::denorm_min(),
+                        std::numeric_limits<T>::max()};
+  int mismatches = 0, near_threshold = 0, cases = 0;
+  auto check = [&](T a, T b, T c, T d) {
+    const T k = kahan_det(a, b, c, d);
+    const int expected = (k > T(0)) - (k < T(0));
+    ++cases;
+    if (det_sign(a, b, c, d) != expected) ++mismatches;
+    if constexpr (std::is_same_v<T, float>) {
+      const double exact = double(a) * double(d) - double(b) * double(c);
+      const double big = std::numeric_limits<float>::max(), ad = double(a) * d, bc = double(b) * c;
+      const bool normal =
+          std::abs(exact) >= std::numeric_limits<float>::min() && std::abs(ad) <= big && std::abs(bc) <= big;
+      if (normal && det_sign(a, b, c, d) != (exact > 0) - (exact < 0)) ++mismatches;
+    }
+    const T ad = a * d, bc = b * c;
+    if (std::abs(ad - bc) <= T(8) * eps * (std::abs(ad) + std::abs(bc)) &&
+        std::abs(ad - bc) >= eps * (std::abs(ad) + std::abs(bc)))
+      ++near_threshold;
+  };
+  for (int i = 0; i < 20000; ++i) {
+    const T a = T(U(rng)), d = T(U(rng)), k = T(std::ldexp(1 + U(rng) / 2, int(8 * U(rng))));
+    const T wobble = T(1) + T(std::round(8 * U(rng))) * eps;  // a d - b c within a few ulps of either sign, or 0
+    const T b = a * k * wobble, c = d / k;
+    for (const int scale :
+         {0, -60, 60, std::numeric_limits<T>::min_exponent + 8, std::numeric_limits<T>::max_exponent / 2})
+      check(std::ldexp(a, scale), std::ldexp(b, scale), c, d);
+    check(a, b, c, d * T(U(rng)));  // a random determinant
+  }
+  for (const T x : specials)
+    for (const T y : specials) check(x, y, T(U(rng)), T(U(rng))), check(T(U(rng)), x, y, T(U(rng)));
+  std::printf("[ %s ] %d cases, %d near the filter's threshold\n", name, cases, near_threshold);
+  EXPECT_EQ(mismatches, 0);
+  EXPECT_GT(near_threshold, cases / 20);  // the inputs do straddle the threshold
+}
+TEST(PolygonNumerics, DetSignIsKahanDetsSignOnNearSingularTinyHugeAndNonFiniteInputs) {
+  expect_det_sign_is_kahan_dets_sign<float>("float");
+  expect_det_sign_is_kahan_dets_sign<double>("double");
+  expect_det_sign_is_kahan_dets_sign<long double>("long double");
 }
 
 // Sec. 6.4: the approximate atan2's forward error, measured over a dense sweep of angles.
