@@ -528,34 +528,51 @@ template <class T, CutDiskInverse M> int pieces(const ProjectedCapView<T>& p, st
   }
 }
 
+// Whether a preimage's left-area lies in a piece's range, and else by how much it lies beyond an end of the range
+// where the next piece begins (a seam: u0 strictly inside (0, 1)); infinite beyond an end of the warp. A piece
+// a = beta u0 ends near pi, so it is compared by right-areas (left-areas lose a tiny neighbour there).
+template <class T> T seam_miss(const Piece<T>& pc, const CutDiskPreimage<T>& pre) {
+  const T inf = std::numeric_limits<T>::infinity();
+  if (pc.alpha == T(0)) {
+    const T miss = pc.right_hi - pre.right_area;  // beyond u_hi
+    return !(miss > T(0)) ? T(0) : pc.u_hi < T(1) ? miss : inf;
+  }
+  const T a_lo_end = piece_left_area(pc, pc.u_lo), a_hi_end = piece_left_area(pc, pc.u_hi);
+  const T a_lo = std::min(a_lo_end, a_hi_end), a_hi = std::max(a_lo_end, a_hi_end);
+  if (pre.left_area < a_lo) return (a_lo == a_lo_end ? pc.u_lo > T(0) : pc.u_hi < T(1)) ? a_lo - pre.left_area : inf;
+  if (pre.left_area > a_hi) return (a_hi == a_lo_end ? pc.u_lo > T(0) : pc.u_hi < T(1)) ? pre.left_area - a_hi : inf;
+  return T(0);
+}
+
 // Density (per projected solid angle) of local direction w, optionally with its preimage (u0, u1). The pieces
-// tile the projected cap: at most one reaches w, except on a seam (the first is taken).
+// tile the projected cap: at most one reaches w, except on a seam (the first is taken). A direction on a seam can
+// miss both pieces' ranges by the rounding of its left-areas (measured up to 1.5 eps pi in float): if it lies in the
+// light's cap, the piece whose seam it misses least.
 template <class T, CutDiskInverse M> T pdf_local(const ProjectedCapView<T>& p, const Vec3<T>& w, Vec2<T>* u = nullptr) {
   std::array<Piece<T>, 2> ps{};
   const int n = pieces<T, M>(p, ps);
-  for (int i = 0; i < n; ++i) {
-    const Piece<T>& pc = ps[i];
-    T dx, dy, hh, area;
-    if (!local_to_disk(p, pc.kind, w, dx, dy, hh, area)) continue;
-    const CutDiskPreimage<T> pre = cut_disk_preimage<T, M>(dx, hh);
-    // A piece a = beta u0 ends near pi, so it is compared by right-areas (left-areas lose a tiny neighbour there).
-    if (pc.alpha == T(0)) {
-      if (pre.right_area < pc.right_hi) continue;
-    } else {
-      const T a_lo = std::min(piece_left_area(pc, pc.u_lo), piece_left_area(pc, pc.u_hi));
-      const T a_hi = std::max(piece_left_area(pc, pc.u_lo), piece_left_area(pc, pc.u_hi));
-      if (pre.left_area < a_lo || pre.left_area > a_hi) continue;
-    }
-    if (u) {
-      (*u)[0] =
-          std::clamp(pc.alpha == T(0) ? pre.left_area / pc.beta : T(1) - pre.left_area / pc.alpha, pc.u_lo, pc.u_hi);
-      (*u)[1] = hh > T(0) ? std::clamp((dy / hh + T(1)) / T(2), T(0), T(1)) : T(0.5);
-    }
-    // |beta| area underflows to 0 for a piece whose left-area scale is subnormal: density not representable, 0.
-    const T den = std::abs(pc.beta) * area;
-    return den > T(0) ? pre.density / den : T(0);
+  int best = -1;
+  T best_miss = std::numeric_limits<T>::infinity(), dy = 0, hh = 0, area = 0;
+  CutDiskPreimage<T> pre{};
+  for (int i = 0; i < n && best_miss > T(0); ++i) {
+    T dx_i, dy_i, hh_i, area_i;
+    if (!local_to_disk(p, ps[i].kind, w, dx_i, dy_i, hh_i, area_i)) continue;
+    const CutDiskPreimage<T> pre_i = cut_disk_preimage<T, M>(dx_i, hh_i);
+    const T miss = seam_miss(ps[i], pre_i);
+    if (!(miss < best_miss)) continue;
+    best = i, best_miss = miss, pre = pre_i, dy = dy_i, hh = hh_i, area = area_i;
   }
-  return T(0);
+  const Vec3<T> axis(p.w_dx, T(0), p.h);  // the light's centre, local
+  if (best < 0 || (best_miss > T(0) && !((w - axis).squaredNorm() <= T(2) * p.sphere.one_minus_cos_max))) return T(0);
+  const Piece<T>& pc = ps[best];
+  if (u) {
+    (*u)[0] =
+        std::clamp(pc.alpha == T(0) ? pre.left_area / pc.beta : T(1) - pre.left_area / pc.alpha, pc.u_lo, pc.u_hi);
+    (*u)[1] = hh > T(0) ? std::clamp((dy / hh + T(1)) / T(2), T(0), T(1)) : T(0.5);
+  }
+  // |beta| area underflows to 0 for a piece whose left-area scale is subnormal: density not representable, 0.
+  const T den = std::abs(pc.beta) * area;
+  return den > T(0) ? pre.density / den : T(0);
 }
 
 }  // namespace projected_cap_detail

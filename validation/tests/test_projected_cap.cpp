@@ -251,6 +251,42 @@ TEST(ProjectedCapQuintic, Case2PiecesMeetExactlyAtTheSeam) {
   EXPECT_LT((back - u).cwiseAbs().maxCoeff(), 1e-12L);
 }
 
+// A sample within a few epsilons of Case 2's seam (u0 near tau) has a positive pdf(direction) and a preimage: the
+// pieces' left-areas round, and such a direction can miss both pieces' ranges by an ulp of pi.
+template <class T, CutDiskInverse M> int seam_samples_without_pdf(const SphereLightGeometry<Real>& gl) {
+  const SphereLightGeometry<T> g{
+      ShadingPoint<T>{gl.shading.position.template cast<T>(), gl.shading.normal.template cast<T>()},
+      SphereLight<T>{gl.light.center.template cast<T>(), T(gl.light.radius)}};
+  const auto v = make_projected_cap_view(g);
+  EXPECT_EQ(v.which_case, 2);
+  const T eps = std::numeric_limits<T>::epsilon();
+  int without = 0;
+  for (int m = -4; m <= 4; ++m)
+    for (int j = 0; j < 64; ++j) {
+      const Vec2<T> u(v.tau * (T(1) + T(m) * eps), (T(j) + T(0.5)) / T(64));
+      const auto s = sample_projected_spherical_cap<T, M>(v, u);
+      if (!s.valid()) continue;
+      Vec2<T> back;
+      if (!(pdf_projected_spherical_cap<T, M>(v, s.direction) > T(0)) ||
+          !invert_projected_spherical_cap<T, M>(v, s.direction, back))
+        ++without;
+    }
+  return without;
+}
+TEST(ProjectedCapPieces, SamplesOnTheSeamHaveTheirPdfAndAPreimageInEveryScalarType) {
+  const Vec3L up(0, 0, 1);
+  for (const auto& [center, radius] : {std::pair{Vec3L(2, 0, 0.5L), 1.0L}, std::pair{Vec3L(5, 0, 0.004L), 1e-2L},
+                                       std::pair{Vec3L(0, 50, 60), 75.0L}}) {
+    const SphereLightGeometry<Real> g{ShadingPoint<Real>{Vec3L::Zero(), up}, SphereLight<Real>{center, radius}};
+    EXPECT_EQ((seam_samples_without_pdf<float, CutDiskInverse::kQuintic>(g)), 0) << radius;
+    EXPECT_EQ((seam_samples_without_pdf<float, CutDiskInverse::kExact>(g)), 0) << radius;
+    EXPECT_EQ((seam_samples_without_pdf<double, CutDiskInverse::kQuintic>(g)), 0) << radius;
+    EXPECT_EQ((seam_samples_without_pdf<double, CutDiskInverse::kExact>(g)), 0) << radius;
+    EXPECT_EQ((seam_samples_without_pdf<long double, CutDiskInverse::kQuintic>(g)), 0) << radius;
+    EXPECT_EQ((seam_samples_without_pdf<long double, CutDiskInverse::kExact>(g)), 0) << radius;
+  }
+}
+
 // u0 = 0 reaches the cut, i.e. the top of the Case-3 lune, which lies on the light's boundary, in every precision,
 // and u0 -> 1 reaches the left end of the disk. With the published ranges the quintic's abscissa at left-area A_D
 // misses -t_x and the lune's top is never sampled (E[cos/pdf; hit] 1.1e-4 low in case3).
