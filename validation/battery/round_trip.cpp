@@ -1,5 +1,6 @@
 // The battery's test "round-trip" (tests.h), for a sampler with an inverse warp: inverse(sample(u)) == u on a grid
-// of primary samples and sample(inverse(w)) == w on a grid of directions over the bounding cap.
+// of primary samples that includes the ends of the warp's pieces, and sample(inverse(w)) == w on a grid of
+// directions over the bounding cap.
 //
 // Errors are in units of u, less what the sampler's rounding explains: a direction is known to about 8 epsilons of
 // the sampler's scalar type, which the inverse turns into a u-error of up to 8 eps / sigma, sigma the warp's smallest
@@ -21,7 +22,7 @@ namespace {
 constexpr Real kInf = std::numeric_limits<Real>::infinity();
 
 // Cells per axis of both grids: 32 x 32 cell centres, which keep 1 / 64 away from the seams u = 0 and 1 (the pole
-// of a polar map, the azimuth's wrap) and never land on u = 1/2.
+// of a polar map, the azimuth's wrap) and never land on u = 1/2; the primary grid adds the ends of the warp's pieces.
 constexpr int kGrid = 32;
 
 // The warp's Jacobian J = (dw/du0, dw/du1) at u by central differences centred on u; ok == false where a point
@@ -104,23 +105,35 @@ struct Grid {
   void fail(Real u0, Real u1) { ++failed, worst.add(kInf, u0, u1); }
 };
 
-// inverse(sample(u)) against u: max |u' - u| over both coordinates, less the rounding's share at u.
+// inverse(sample(u)) against u at one point: |u' - u| over both coordinates, less the rounding's share at u.
+void primary_point(const SamplerUnderTest& s, Real same, Real u0, Real u1, Grid& g) {
+  const Sample x = s.sample(double(u0), double(u1));
+  if (!x.valid) return;  // a declined sample fails pdf-consistency and chi2
+  ++g.checked;
+  const auto back = s.inverse(x.direction);
+  if (!back || !in_unit_square(*back)) return g.fail(u0, u1);
+  const Real e = std::max(std::abs((*back)[0] - u0), std::abs((*back)[1] - u1));
+  g.add(s, e, beyond_rounding(e, same, Jacobian(s, u0, u1, same)), u0, u1);
+}
+
+// The u of the cell centres, and 0, 1 and 2 of the sampler's epsilons (relative) either side of each declared kink
+// in (0, 1): a kink ends a piece of the warp (a sector, a piece of the disk), and there an inversion's clamps and
+// rounding guards act, which the cell centres almost never reach.
+std::vector<Real> primary_coordinates(const std::vector<Real>& kinks, Real eps) {
+  std::vector<Real> u;
+  for (int i = 0; i < kGrid; ++i) u.push_back((i + Real(0.5)) / kGrid);
+  for (const Real k : kinks)
+    if (k > 0 && k < 1)
+      for (int m = -2; m <= 2; ++m) u.push_back(std::min<Real>(k * (1 + m * eps), std::nextafter(1.0, 0.0)));
+  return u;
+}
+
+// inverse(sample(u)) against u on the grid of primary_coordinates in u0 and u1.
 Grid primary_grid(const SamplerUnderTest& s, Real same) {
+  const Real eps = scalar_epsilon(s.scalar);
   Grid g;
-  for (int i = 0; i < kGrid; ++i)
-    for (int j = 0; j < kGrid; ++j) {
-      const Real u0 = (i + Real(0.5)) / kGrid, u1 = (j + Real(0.5)) / kGrid;
-      const Sample x = s.sample(double(u0), double(u1));
-      if (!x.valid) continue;  // a declined sample fails pdf-consistency and chi2
-      ++g.checked;
-      const auto back = s.inverse(x.direction);
-      if (!back || !in_unit_square(*back)) {
-        g.fail(u0, u1);
-        continue;
-      }
-      const Real e = std::max(std::abs((*back)[0] - u0), std::abs((*back)[1] - u1));
-      g.add(s, e, beyond_rounding(e, same, Jacobian(s, u0, u1, same)), u0, u1);
-    }
+  for (const Real u0 : primary_coordinates(s.kinks_u0, eps))
+    for (const Real u1 : primary_coordinates(s.kinks_u1, eps)) primary_point(s, same, u0, u1, g);
   return g;
 }
 

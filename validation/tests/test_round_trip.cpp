@@ -126,6 +126,23 @@ TEST(RoundTrip, AnInverseWithoutAPreimageInsideTheSupportFails) {
   EXPECT_FALSE(battery::round_trip(s).passed);
 }
 
+// A clamp on the wrong side of a piece acts only within a few epsilons of the piece's end: the cell centres never
+// reach it, the points beside a declared kink do.
+TEST(RoundTrip, AnInverseWrongOnlyAtTheEndOfAPieceFailsWhereTheKinkIsDeclared) {
+  SamplerUnderTest s = cone();
+  const auto inverse = s.inverse;
+  s.inverse = [inverse](const Vec3L& w) {
+    auto u = inverse(w);
+    if (u && std::abs((*u)[0] - 0.4L) < 1e-12L) (*u)[0] = 0.1L;
+    return u;
+  };
+  EXPECT_TRUE(battery::round_trip(s).passed) << "no kink declared: the grid does not reach u0 = 0.4";
+  s.kinks_u0 = {0.4L};
+  const TestResult r = battery::round_trip(s);
+  EXPECT_FALSE(r.passed) << detail(r);
+  EXPECT_NEAR(r.statistic, 0.3, 1e-9);
+}
+
 TEST(RoundTrip, ThePolygonSamplersTwoTangentLineIterationsPassAndFewerFail) {
   for (int iterations : {2, 3}) {
     const TestResult r = battery::round_trip(polygon_projected(iterations));
