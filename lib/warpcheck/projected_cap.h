@@ -745,8 +745,28 @@ template <class T, CutDiskInverse M> struct SphereProjectedCapKernel {
     const View v = make_projected_cap_view(g);
     return v.valid() ? projected_cap_bounding_cap(v) : make_sphere_view(g).cap();
   }
-  // The horizon, where the cut cap ends and the density's cosine reaches 0.
-  static std::vector<Vec3<T>> boundary_planes(const Geometry& g) { return {g.shading.normal.normalized()}; }
+  // The horizon, where the cut cap ends and the density's cosine reaches 0; for the quintic in Case 2 also the
+  // mirrored disk's kink (kinks_u0) at d_x = 0, which is local w_x = 0.
+  static std::vector<Vec3<T>> boundary_planes(const Geometry& g) {
+    std::vector<Vec3<T>> planes{g.shading.normal.normalized()};
+    if constexpr (kQuintic) {
+      const View v = make_projected_cap_view(g);
+      if (v.valid() && v.which_case == 2) planes.push_back(v.x);
+    }
+    return planes;
+  }
+  // Small circles where the quintic's density kinks (kinks_u0): on the ellipse piece of Cases 1-2 at d_x = 0 (local
+  // w_x = c_x), and in Case 2 on the seam between the pieces (local w_x = t_x, where the disk piece begins).
+  static std::vector<Cap<T>> boundary_caps(const Geometry& g) {
+    std::vector<Cap<T>> caps;
+    if constexpr (kQuintic) {
+      const View v = make_projected_cap_view(g);
+      if (!v.valid() || v.which_case > 2) return caps;
+      if (v.r_x > T(0)) caps.push_back(Cap<T>{v.x, v.one_minus_cx});
+      if (v.which_case == 2) caps.push_back(Cap<T>{v.x, (v.w_dx - v.v) / v.w_dx});  // 1 - t_x, t_x = v / w_dx
+    }
+    return caps;
+  }
   // A_E + A_D: the projected solid angle in Cases 1-2 (Case 3's density is not uniform in the disk).
   static T normaliser(const View& v) { return v.total; }
   // Case 2's threshold tau (the warp passes from the ellipse to the disk: continuous, its derivative jumps) and,
