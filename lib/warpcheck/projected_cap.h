@@ -537,10 +537,10 @@ template <class T> T seam_miss(const Piece<T>& pc, const CutDiskPreimage<T>& pre
     const T miss = pc.right_hi - pre.right_area;  // beyond u_hi
     return !(miss > T(0)) ? T(0) : pc.u_hi < T(1) ? miss : inf;
   }
-  const T a_lo_end = piece_left_area(pc, pc.u_lo), a_hi_end = piece_left_area(pc, pc.u_hi);
-  const T a_lo = std::min(a_lo_end, a_hi_end), a_hi = std::max(a_lo_end, a_hi_end);
-  if (pre.left_area < a_lo) return (a_lo == a_lo_end ? pc.u_lo > T(0) : pc.u_hi < T(1)) ? a_lo - pre.left_area : inf;
-  if (pre.left_area > a_hi) return (a_hi == a_lo_end ? pc.u_lo > T(0) : pc.u_hi < T(1)) ? pre.left_area - a_hi : inf;
+  const T a_at_u_lo = piece_left_area(pc, pc.u_lo), a_at_u_hi = piece_left_area(pc, pc.u_hi);
+  const T a_lo = std::min(a_at_u_lo, a_at_u_hi), a_hi = std::max(a_at_u_lo, a_at_u_hi);
+  if (pre.left_area < a_lo) return (a_lo == a_at_u_lo ? pc.u_lo > T(0) : pc.u_hi < T(1)) ? a_lo - pre.left_area : inf;
+  if (pre.left_area > a_hi) return (a_hi == a_at_u_lo ? pc.u_lo > T(0) : pc.u_hi < T(1)) ? pre.left_area - a_hi : inf;
   return T(0);
 }
 
@@ -562,8 +562,9 @@ template <class T, CutDiskInverse M> T pdf_local(const ProjectedCapView<T>& p, c
     if (!(miss < best_miss)) continue;
     best = i, best_miss = miss, pre = pre_i, dy = dy_i, hh = hh_i, area = area_i;
   }
-  const Vec3<T> axis(p.w_dx, T(0), p.h);  // the light's centre, local
-  if (best < 0 || (best_miss > T(0) && !((w - axis).squaredNorm() <= T(2) * p.sphere.one_minus_cos_max))) return T(0);
+  if (best < 0) return T(0);
+  // The light's cap in the local frame, whose x axis is the light centre's horizontal direction.
+  if (best_miss > T(0) && !Cap<T>{Vec3<T>(p.w_dx, T(0), p.h), p.sphere.one_minus_cos_max}.contains(w)) return T(0);
   const Piece<T>& pc = ps[best];
   if (u) {
     (*u)[0] =
