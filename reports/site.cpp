@@ -950,7 +950,7 @@ std::string run_summary(const BatteryRun& run, const ReportOptions& opt, const R
     << (run.seed ? "; seed " + std::to_string(*run.seed) : "") << ".</p>\n";
   if (run.complete && !*run.complete)
     x << "<div class=\"banner warn\">This run is INCOMPLETE (\"complete\": false): the battery was interrupted; "
-         "cases it did not reach are missing.</div>\n";
+         "cases it did not reach are missing, and so are the power figures (written when a run completes).</div>\n";
   std::vector<const TestResult*> failing;
   for (const TestResult& r : run.results)
     if (r.failed()) failing.push_back(&r);

@@ -1,6 +1,7 @@
 // Specification of `warpcheck validate` as a process: with --json FILE --resume, a run killed with SIGKILL keeps the
-// cases it finished in FILE, bit for bit, and the same command with --resume runs only the others; a file from
-// other --samples is refused. Its progress on stderr when stderr is not a terminal.
+// cases it finished in FILE, bit for bit (the power figures come with the completed run), and the same command with
+// --resume runs only the others; a file from other --samples is refused. Its progress on stderr when stderr is not a
+// terminal.
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
@@ -60,6 +61,7 @@ TEST(ValidateCli, AKilledRunResumedWithTheSameCommandKeepsWhatItFinishedAndRunsO
   first = peek(json);
   ASSERT_TRUE(first && !first->results.empty()) << read_all(dir / "killed.err");
   ASSERT_EQ(first->complete, false) << "the run finished before it was killed";
+  EXPECT_TRUE(first->power.empty()) << "a checkpoint carries no power figures; the completed run does";
   for (const TestResult& r : first->results) ASSERT_EQ(r.config, "far");
 
   std::vector<std::string> resume = command;
@@ -68,6 +70,7 @@ TEST(ValidateCli, AKilledRunResumedWithTheSameCommandKeepsWhatItFinishedAndRunsO
   EXPECT_NE(read_all(dir / "resumed.err").find("1 cases done, 1 to run"), std::string::npos);
   const BatteryRun done = parse_battery_json(read_all(json));
   EXPECT_EQ(done.complete, true);
+  EXPECT_EQ(done.power.size(), 2u);  // one per case
   // The finished case's results as they were, then the other case's, each once.
   ASSERT_GT(done.results.size(), first->results.size());
   for (std::size_t i = 0; i < done.results.size(); ++i) {
