@@ -18,6 +18,8 @@ struct CapGridSpec {
   Real bend = 1e-2L;                        // a slab is halved where its second difference exceeds this
   int max_depth = 8;                        // ... up to this many times
   bool beside_bends = true;                 // ... and so is a slab beside one that bends (cap_grid.cpp)
+  Real edge_band = 0;                       // rings with t > 1 - edge_band, where a rounded pdf's edge lies, are
+                                            // integrated by a dense midpoint rule in phi (cap_grid.cpp)
   int threads = 1;
 };
 
