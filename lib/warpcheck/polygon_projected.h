@@ -242,9 +242,13 @@ template <class T> Vec2<T> clamp_to_sector(const ProjectedSector<T>& s, const Ve
 }
 
 // The decentral inversion: initialisation plus `iterations` steps, each kept inside the sector. `target` is the
-// area from s0, `rest` the area to s1 (decentral_residual).
+// area from s0, `rest` the area to s1 (decentral_residual). The sector's ends are exact: there Eq. 6's constant
+// term vanishes, tau = 0 is a root, and where the ellipses meet at that end its linear term's sign is rounding,
+// which can make the increasing root the other one, anywhere in the sector.
 template <class T, bool kBiased = false>
 Vec2<T> invert_decentral_sector(const ProjectedSector<T>& s, T target, T rest, int iterations) {
+  if (!(target > T(0))) return l1_normalized(s.s0);
+  if (!(rest > T(0))) return l1_normalized(s.s1);
   Vec2<T> w = clamp_to_sector(s, decentral_initialization<T, kBiased>(s, target));
   for (int k = 0; k < iterations; ++k) w = clamp_to_sector(s, decentral_iteration<T, kBiased>(s, target, rest, w));
   return w;
