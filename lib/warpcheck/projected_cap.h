@@ -547,7 +547,9 @@ template <class T> T seam_miss(const Piece<T>& pc, const CutDiskPreimage<T>& pre
 // Density (per projected solid angle) of local direction w, optionally with its preimage (u0, u1). The pieces
 // tile the projected cap: at most one reaches w, except on a seam (the first is taken). A direction on a seam can
 // miss both pieces' ranges by the rounding of its left-areas (measured up to 1.5 eps pi in float): if it lies in the
-// light's cap, the piece whose seam it misses least.
+// light's cap and within 8 eps pi of a seam, the piece whose seam it misses least. (Farther, the other piece's
+// left-area is its mirror image's: a direction on the ellipse's edge that the ellipse refuses by rounding would
+// get the disk piece's preimage and density of another direction.)
 template <class T, CutDiskInverse M> T pdf_local(const ProjectedCapView<T>& p, const Vec3<T>& w, Vec2<T>* u = nullptr) {
   std::array<Piece<T>, 2> ps{};
   const int n = pieces<T, M>(p, ps);
@@ -564,7 +566,9 @@ template <class T, CutDiskInverse M> T pdf_local(const ProjectedCapView<T>& p, c
   }
   if (best < 0) return T(0);
   // The light's cap in the local frame, whose x axis is the light centre's horizontal direction.
-  if (best_miss > T(0) && !Cap<T>{Vec3<T>(p.w_dx, T(0), p.h), p.sphere.one_minus_cos_max}.contains(w)) return T(0);
+  if (best_miss > T(0) && (best_miss > T(8) * std::numeric_limits<T>::epsilon() * kPi<T> ||
+                           !Cap<T>{Vec3<T>(p.w_dx, T(0), p.h), p.sphere.one_minus_cos_max}.contains(w)))
+    return T(0);
   const Piece<T>& pc = ps[best];
   if (u) {
     (*u)[0] =

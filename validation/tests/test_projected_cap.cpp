@@ -287,6 +287,43 @@ TEST(ProjectedCapPieces, SamplesOnTheSeamHaveTheirPdfAndAPreimageInEveryScalarTy
   }
 }
 
+// A sample on an edge of its chord (u1 = 0 or 1) lies on the light's boundary, where its own piece can refuse it by
+// rounding. Its pdf and preimage are then its own or none, never another piece's: the disk piece's left-area of a
+// direction beyond the seam is its mirror image's, and with the seam fallback unbounded such a direction got a
+// preimage whose sample lies up to 0.24 rad away (sphere-projected-cap-exact long double case2, u = (0.1, 0)).
+template <class T, CutDiskInverse M> Real edge_round_trip_over_tolerance(const SphereLightGeometry<Real>& gl) {
+  const SphereLightGeometry<T> g{
+      ShadingPoint<T>{gl.shading.position.template cast<T>(), gl.shading.normal.template cast<T>()},
+      SphereLight<T>{gl.light.center.template cast<T>(), T(gl.light.radius)}};
+  const auto v = make_projected_cap_view(g);
+  Real worst = 0;
+  if (!v.valid()) return worst;
+  for (int j = 0; j < 64; ++j)
+    for (T u1 : {T(0), T(1)}) {
+      const auto s = sample_projected_spherical_cap<T, M>(v, Vec2<T>((T(j) + T(0.5)) / T(64), u1));
+      Vec2<T> back;
+      if (!s.valid() || !invert_projected_spherical_cap<T, M>(v, s.direction, back)) continue;
+      const auto again = sample_projected_spherical_cap<T, M>(v, back);
+      if (!again.valid()) return std::numeric_limits<Real>::infinity();
+      worst = std::max(worst, (to_long(again.direction) - to_long(s.direction)).norm());
+    }
+  // Against a thousandth of the light's angular radius plus T's rounding: a preimage of the direction itself maps
+  // back within rounding.
+  const Real d = (gl.light.center - gl.shading.position).norm();
+  return worst /
+         (1e-3L * std::asin(std::min<Real>(1, gl.light.radius / d)) + 64 * Real(std::numeric_limits<T>::epsilon()));
+}
+// Double and long double: in float the inverse of a tiny light is itself only good to a few percent of its size
+// (tiny-straddling: 1.5e-4 rad of 2e-3, with or without the mirror), as large as the mirror's error there.
+TEST(ProjectedCapPieces, ASampleOnAnEdgeOfItsChordHasItsOwnPreimageOrNone) {
+  for (const ProjectedCapConfig& c : projected_cap_configs()) {
+    EXPECT_LE((edge_round_trip_over_tolerance<double, CutDiskInverse::kQuintic>(c.g)), 1) << c.name;
+    EXPECT_LE((edge_round_trip_over_tolerance<double, CutDiskInverse::kExact>(c.g)), 1) << c.name;
+    EXPECT_LE((edge_round_trip_over_tolerance<long double, CutDiskInverse::kQuintic>(c.g)), 1) << c.name;
+    EXPECT_LE((edge_round_trip_over_tolerance<long double, CutDiskInverse::kExact>(c.g)), 1) << c.name;
+  }
+}
+
 // u0 = 0 reaches the cut, i.e. the top of the Case-3 lune, which lies on the light's boundary, in every precision,
 // and u0 -> 1 reaches the left end of the disk. With the published ranges the quintic's abscissa at left-area A_D
 // misses -t_x and the lune's top is never sampled (E[cos/pdf; hit] 1.1e-4 low in case3).
