@@ -7,6 +7,7 @@
 #include <boost/math/quadrature/gauss.hpp>
 #include <boost/math/quadrature/gauss_kronrod.hpp>
 #include <cmath>
+#include <mutex>
 
 #include "battery/circles.h"
 #include "battery/drawing.h"
@@ -367,21 +368,29 @@ void integrate_lines(const SamplerUnderTest& s, const CapGridSpec& sp, const Cap
   for (std::size_t k = 0; k + 1 < sp.xa.size(); ++k) out.Fa[k + 1] = out.Fa[k] + slab_mass[k];
 }
 
-// A ring within the edge band (CapGridSpec::edge_band): the midpoint rule on kEdgeBandNodes equally spaced azimuths
-// per column. There a rounded pdf is 0 or not by its directions' rounding, a pattern far finer than any rule's
-// nodes, so the ring's integral is an average over that pattern: the Gauss-Kronrod pieces' 480 nodes leave about
-// 2% of a float ring's zero fraction to chance (sqrt(f (1 - f) / 480)), these 16384 about 0.4%.
+// A ring within the edge band (t > 1 - CapGridSpec::resolution): the midpoint rule on kEdgeBandNodes equally spaced
+// azimuths per column, whose (cos, sin) the caller computes once. There a rounded pdf is 0 or not by its
+// directions' rounding, a pattern far finer than any rule's nodes, so the ring's integral is an average over that
+// pattern: the Gauss-Kronrod pieces' 480 nodes leave about 2% of a float ring's zero fraction to chance
+// (sqrt(f (1 - f) / 480)), these 16384 about 0.4%.
 constexpr int kEdgeBandNodes = 512;
-void edge_band_ring(const SamplerUnderTest& s, const Vec3L& centre, const Vec3L& ex, const Vec3L& ey,
-                    std::vector<Real>& ring, long& calls) {
-  const std::size_t A = ring.size(), n = A * kEdgeBandNodes;
+std::vector<std::array<Real, 2>> edge_band_azimuths(int columns) {
+  const std::size_t n = std::size_t(columns) * kEdgeBandNodes;
+  std::vector<std::array<Real, 2>> cs(n);
+  const Real h = kTwoPi<Real> / Real(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Real phi = h * (Real(i) + Real(0.5));
+    cs[i] = {cosine(phi), sine(phi)};
+  }
+  return cs;
+}
+void edge_band_ring(const SamplerUnderTest& s, const std::vector<std::array<Real, 2>>& azimuths, const Vec3L& centre,
+                    const Vec3L& ex, const Vec3L& ey, std::vector<Real>& ring, long& calls) {
+  const std::size_t n = azimuths.size();
   const Real h = kTwoPi<Real> / Real(n);
   std::vector<Vec3L> w(n);
   std::vector<Real> f(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const Real phi = h * (Real(i) + Real(0.5));
-    w[i] = centre + cosine(phi) * ex + sine(phi) * ey;
-  }
+  for (std::size_t i = 0; i < n; ++i) w[i] = centre + azimuths[i][0] * ex + azimuths[i][1] * ey;
   pdf_many(s, w, f);
   calls += long(n);
   for (std::size_t i = 0; i < n; ++i)
@@ -414,13 +423,18 @@ void integrate_rings(const SamplerUnderTest& s, const CapGridSpec& sp, const Cap
       table[std::size_t(c) * 15 + i] = {cosine(phi), sine(phi)};
     }
   const Vec3L ex = cf.fr.to_world(Vec3L(1, 0, 0)), ey = cf.fr.to_world(Vec3L(0, 1, 0));
+  // The edge band's azimuths, computed by the first ring in it (float: the last few KS slabs; in double and long
+  // double, whose band is about 1e-11 wide, no ring).
+  std::once_flag band_once;
+  std::vector<std::array<Real, 2>> band_azimuths;
   auto ring_at = [&](Real t, std::vector<Real>& ring, long& calls) {
     ring.assign(std::size_t(A), 0);
     const Real o = t * cf.omc;
     const Real cos_c = 1 - o, sin_c = std::sqrt(std::max<Real>(0, o * (2 - o)));
     const Vec3L centre = cos_c * cf.fr.to_world(Vec3L(0, 0, 1));
-    if (t > 1 - sp.edge_band) {
-      edge_band_ring(s, centre, sin_c * ex, sin_c * ey, ring, calls);
+    if (t > 1 - sp.resolution) {
+      std::call_once(band_once, [&] { band_azimuths = edge_band_azimuths(A); });
+      edge_band_ring(s, band_azimuths, centre, sin_c * ex, sin_c * ey, ring, calls);
       return;
     }
     std::vector<Real> phi_edges = phi_edges_whole;

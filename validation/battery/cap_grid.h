@@ -14,12 +14,12 @@ struct CapGridSpec {
   std::vector<Real> xr, xa;                 // KS nodes: t, and phi / (2 pi), each from 0 to 1
   Real rel_tol = 1e-8L;                     // relative tolerance of each 1D piece's Gauss-Kronrod rule
   Real resolution = 0;                      // slabs are not halved below this width in t or phi (the sampler's
-                                            // scalar cannot tell directions closer than that apart)
+                                            // scalar cannot tell directions closer than that apart), and rings
+                                            // with t > 1 - resolution, where a rounded pdf's edge lies, are
+                                            // integrated by a dense midpoint rule in phi (cap_grid.cpp)
   Real bend = 1e-2L;                        // a slab is halved where its second difference exceeds this
   int max_depth = 8;                        // ... up to this many times
   bool beside_bends = true;                 // ... and so is a slab beside one that bends (cap_grid.cpp)
-  Real edge_band = 0;                       // rings with t > 1 - edge_band, where a rounded pdf's edge lies, are
-                                            // integrated by a dense midpoint rule in phi (cap_grid.cpp)
   int threads = 1;
 };
 

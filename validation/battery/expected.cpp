@@ -146,7 +146,6 @@ Expected expected_integrals(const SamplerUnderTest& s, const BatteryOptions& o) 
   spec.xr = e.ks.xr, spec.xa = e.ks.xa;
   spec.rel_tol = o.quadrature_tolerance, spec.threads = thread_count(o);
   spec.resolution = rounding_slack(s);  // in t and phi
-  spec.edge_band = rounding_slack(s);
   // Halving beside a bend buys accuracy far below a float pdf's rounding, and where that rounding is coarse (a
   // near-singular LTC's lobe, 1e-4 rad wide, in float directions) more nodes there move the grid's total by
   // 4.6e-5, which the chi-square's outside cell (1 - total) reads as missing samples.

@@ -419,8 +419,8 @@ int validate_main(const std::vector<std::string>& a) {
     progress.finished(label, std::chrono::duration<double>(std::chrono::steady_clock::now() - case_start).count());
     run.results.insert(run.results.end(), r.begin(), r.end());
     // So far, judged together, and marked incomplete: a killed run keeps what it finished. The power figures wait
-    // for the completed run: they depend on its final level, and computing them for every case after each one
-    // made the checkpoints quadratic in the run's length (0.17 s each at the registry's 477 cases).
+    // for the completed run: they depend on its final level, and computing them for every case after each case
+    // would make the checkpoints quadratic in the run's length (0.15 s each at the registry's 4635 results).
     if (!v.json.empty()) {
       BatteryRun partial = run;
       apply_correction(partial.results, run.alpha, run.correction);
