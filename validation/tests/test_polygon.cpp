@@ -408,9 +408,9 @@ TEST(PolygonProjected, BackwardErrorAfterTwoIterationsOnRandomDecentralCases) {
 
 // u0 = 0 and u0 = 1 (a quasi-random sequence's first point) are the ends of the first and last sectors, where
 // the decentral inversion's target or rest is exactly 0: the sample lies on that end, and its inverse gives u0
-// back. Eq. 6 at an end has the root tau = 0; before the ends were taken exactly, the increasing root was the other
-// one for many of these decentral polygons (inverse u0 off by up to 0.999). A sample on the horizon (the end is a
-// clipped vertex there) has pdf 0 and is declined.
+// back. Eq. 6 at an end has the root tau = 0, and its increasing root can be the other one (an inversion that does
+// not take the ends exactly lands anywhere in the sector). A sample on the horizon (the end is a clipped vertex
+// there) has pdf 0 and is declined.
 template <class T> void expect_sector_ends_map_to_their_ends(unsigned seed) {
   std::mt19937_64 rng(seed);
   int decentral = 0, probes = 0;

@@ -289,8 +289,7 @@ TEST(ProjectedCapPieces, SamplesOnTheSeamHaveTheirPdfAndAPreimageInEveryScalarTy
 
 // A sample on an edge of its chord (u1 = 0 or 1) lies on the light's boundary, where its own piece can refuse it by
 // rounding. Its pdf and preimage are then its own or none, never another piece's: the disk piece's left-area of a
-// direction beyond the seam is its mirror image's, and with the seam fallback unbounded such a direction got a
-// preimage whose sample lies up to 0.24 rad away (sphere-projected-cap-exact long double case2, u = (0.1, 0)).
+// direction beyond the seam is its mirror image's, whose preimage maps to a direction up to a light's width away.
 template <class T, CutDiskInverse M> Real edge_round_trip_over_tolerance(const SphereLightGeometry<Real>& gl) {
   const SphereLightGeometry<T> g{
       ShadingPoint<T>{gl.shading.position.template cast<T>(), gl.shading.normal.template cast<T>()},
