@@ -9,9 +9,11 @@
 //   sampling: au = xi_0 S + k, k = 2 pi - gamma_2 - gamma_3; fu = (cos(au) b0 - b1) / sin(au);
 //   cu = sign(fu) / sqrt(fu^2 + b0^2); xu = -cu z0 / sqrt(1 - cu^2) clamped to [x0, x1];
 //   d = sqrt(xu^2 + z0^2); h0 = y0 / sqrt(d^2 + y0^2); h1 = y1 / sqrt(d^2 + y1^2);
-//   hv = h0 + xi_1 (h1 - h0); yv = hv d / sqrt(1 - hv^2) (or y1 when hv^2 >= 1 - eps).
+//   hv = h0 + xi_1 (h1 - h0); yv = hv d / sqrt(1 - hv^2) (or the end y0 or y1 on hv's side when hv^2 >= 1 - eps).
 // pdf = 1 / S inside the rectangle's cone. Like Arvo 1995, S cancels for small rectangles (kept on purpose).
-// The only addition: a non-finite result becomes "no sample" (house rule: never NaN).
+// Two departures: a non-finite result becomes "no sample" (house rule: never NaN), and where hv^2 >= 1 - eps the
+// published listing takes y1 whatever hv's sign, which puts the samples of xi_1 ~ 0 on a strip reaching far to -y
+// (y0 / d beyond ~3e3 in float, ~7e7 in double) at its other end; here they take y0.
 #pragma once
 
 #include "warpcheck/polygon.h"
@@ -93,7 +95,9 @@ DirectionSample<T> sample_spherical_rectangle(const SphericalRectangleView<T>& v
   };
   const T h0 = sine_of(v.y0), h1 = sine_of(v.y1);
   const T hv = h0 + xi[1] * (h1 - h0), hv2 = hv * hv;
-  const T yv = hv2 < T(1) - std::numeric_limits<T>::epsilon() ? hv * d / std::sqrt(T(1) - hv2) : v.y1;
+  // Where |hv| rounds to 1, the quotient's limit: the end of [y0, y1] on hv's side.
+  const T y_end = hv > T(0) ? v.y1 : v.y0;
+  const T yv = hv2 < T(1) - std::numeric_limits<T>::epsilon() ? hv * d / std::sqrt(T(1) - hv2) : y_end;
   const Vec3<T> p = xu * v.x + yv * v.y + v.z0 * v.z;
   DirectionSample<T> out;
   if (!all_finite(p)) return DirectionSample<T>::none(NoSample::kNonFinite);

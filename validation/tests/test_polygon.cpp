@@ -478,6 +478,31 @@ TEST(PolygonBaselines, UrenaMatchesTheReferenceSolidAngleAndRejectsNonRectangles
   EXPECT_EQ(sample_spherical_rectangle(trap, Vec2<double>(0.5, 0.5)).reason, NoSample::kInvalidGeometry);
 }
 
+// A 2 x (len + 1) strip 1 above the shading point, reaching to y = -len: for xi_1 ~ 0 hv rounds to -1 (float from
+// len ~ 3e3, double from ~ 7e7), where yv's limit is y0, the near end. Compared with the long double sampler.
+template <class T> double urena_worst_at_xi1_zero_on_a_long_strip(L len) {
+  const auto g =
+      geom<L>(Vec3<L>::Zero(), Vec3<L>(0, 0, 1),
+              PolygonLight<L>{Vec3<L>(-1, -len, 1), Vec3<L>(1, -len, 1), Vec3<L>(1, 1, 1), Vec3<L>(-1, 1, 1)});
+  const auto v = make_spherical_rectangle_view(g.cast<T>());
+  const auto ref = make_spherical_rectangle_view(g);
+  EXPECT_TRUE(v.valid() && ref.valid());
+  double worst = 0;
+  for (int i = 0; i <= 100; ++i) {
+    const T u0 = T(i) / T(100);
+    const auto a = sample_spherical_rectangle(v, Vec2<T>(u0, T(0)));
+    const auto b = sample_spherical_rectangle(ref, Vec2<L>(L(u0), L(0)));
+    EXPECT_TRUE(a.valid() && b.valid());
+    if (a.valid() && b.valid()) worst = std::max(worst, double((a.direction.template cast<L>() - b.direction).norm()));
+  }
+  return worst;
+}
+
+TEST(PolygonBaselines, UrenaSamplesAtXiOneZeroOnAStripReachingFarToMinusYLieAtItsNearEnd) {
+  EXPECT_LE(urena_worst_at_xi1_zero_on_a_long_strip<float>(1e4L), 1e-3);
+  EXPECT_LE(urena_worst_at_xi1_zero_on_a_long_strip<double>(1e9L), 1e-9);
+}
+
 TEST(PolygonGeometry, BoundingCapContainsThePolygonTightly) {
   std::mt19937_64 rng(37);
   for (int trial = 0; trial < 100; ++trial) {
