@@ -65,7 +65,15 @@ template <class T> struct PolygonLightGeometry {
 
 // a d - b c by Kahan's algorithm with FMAs: a few ulps and the correct sign (Jeannerod, Louvet & Muller 2013), as
 // Peters 2021 Sec. 3.7 needs for short edges.
+// In x87 long double the FMAs are an emulation, several times the plain difference: where fl(a d) - fl(b c) keeps at
+// least half of |a d| + |b c| (no cancellation, both products finite, the difference normal), its relative error is
+// at most 3u (u = eps / 2) against Kahan's 2u, with the exact sign, and it is taken instead.
 template <class T> T kahan_det(T a, T b, T c, T d) {
+  if constexpr (std::is_same_v<T, long double> && kX87LongDouble) {
+    const T ad = a * d, bc = b * c, det = ad - bc, scale = std::abs(ad) + std::abs(bc);
+    if (std::isfinite(scale) && std::abs(det) >= std::numeric_limits<T>::min() && T(2) * std::abs(det) >= scale)
+      return det;
+  }
   const T w = b * c;
   const T e = negated_product_error(b, c, w);  // w - b c, exactly
   const T f = fused_multiply_add(a, d, -w);
