@@ -290,6 +290,16 @@ TEST(PolygonNumerics, KahanCrossIsAccurateForShortEdgesFarAway) {
   EXPECT_GT(worst_plain, 100 * worst_kahan);  // the remedy is needed: the plain cross product cancels
 }
 
+// Random a, b, c, d in about [-1, 1] with b c = a d (1 + j eps) for an integer |j| <= 4: a d - b c within a few ulps
+// of either sign, or 0.
+template <class T> std::array<T, 4> nearly_singular_det_inputs(std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> U(-1, 1);
+  const T eps = std::numeric_limits<T>::epsilon();
+  const T a = T(U(rng)), d = T(U(rng)), k = T(std::ldexp(1 + U(rng) / 2, int(8 * U(rng))));
+  const T wobble = T(1) + T(std::round(8 * U(rng))) * eps;
+  return {a, a * k * wobble, d / k, d};
+}
+
 // det_sign's filter never decides differently from kahan_det: on random, nearly singular (a d and b c equal to within
 // a few ulps, both sides of the filter's threshold), subnormal, overflowing and non-finite inputs. Float's sign is
 // also checked against the exact one where the products and the determinant are normal floats (float products are
@@ -323,9 +333,7 @@ template <class T> void expect_det_sign_is_kahan_dets_sign(const char* name) {
       ++near_threshold;
   };
   for (int i = 0; i < 20000; ++i) {
-    const T a = T(U(rng)), d = T(U(rng)), k = T(std::ldexp(1 + U(rng) / 2, int(8 * U(rng))));
-    const T wobble = T(1) + T(std::round(8 * U(rng))) * eps;  // a d - b c within a few ulps of either sign, or 0
-    const T b = a * k * wobble, c = d / k;
+    const auto [a, b, c, d] = nearly_singular_det_inputs<T>(rng);
     for (const int scale :
          {0, -60, 60, std::numeric_limits<T>::min_exponent + 8, std::numeric_limits<T>::max_exponent / 2})
       check(std::ldexp(a, scale), std::ldexp(b, scale), c, d);
@@ -353,8 +361,7 @@ template <class T> double kahan_det_worst_relative_error_in_units_of_roundoff() 
   const T eps = std::numeric_limits<T>::epsilon();
   double worst = 0;
   for (int i = 0; i < 20000; ++i) {
-    const T a = T(U(rng)), d = T(U(rng)), k = T(std::ldexp(1 + U(rng) / 2, int(8 * U(rng))));
-    const T b = a * k * (T(1) + T(std::round(8 * U(rng))) * eps), c = d / k;
+    const auto [a, b, c, d] = nearly_singular_det_inputs<T>(rng);
     for (const T dd : {d, d * T(U(rng))}) {
       const Exact exact = Exact(a) * Exact(dd) - Exact(b) * Exact(c);
       const T got = kahan_det(a, b, c, dd);
