@@ -10,6 +10,14 @@
 #include <sstream>
 #include <stdexcept>
 
+// On x86-64, an AVX2 clone beside the portable code, picked at run time: twice the vector width, and the same
+// results bit for bit (AVX2 without FMA, so no product is contracted).
+#if defined(__x86_64__) && defined(__GNUC__)
+#define WARPCHECK_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define WARPCHECK_VECTOR_CLONES
+#endif
+
 namespace warpcheck::validation::battery {
 namespace {
 
@@ -172,8 +180,8 @@ Placement CapBinner::place_exact(const Vec3L& direction) const {
 }
 
 // Branch-free, so that the loop over a block vectorises.
-void CapBinner::fast_coordinates(std::size_t n, const double* x, const double* y, const double* z, double* t,
-                                 double* a) const {
+WARPCHECK_VECTOR_CLONES void CapBinner::fast_coordinates(std::size_t n, const double* x, const double* y,
+                                                         const double* z, double* t, double* a) const {
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   for (std::size_t i = 0; i < n; ++i) {
     // 1 / sqrt(1 + delta) by its series to delta^3: for |delta| < 2^-14 the rest is below (35/128) delta^4 < 0.03 u.
@@ -197,15 +205,15 @@ std::optional<Placement> CapBinner::place_coordinates(double t, double a) const 
   if (t_lo > inside_t_) return Placement{.outside = true};
   if (!(t_hi <= inside_t_)) return std::nullopt;
   // place_exact clamps t to 1 (the slack's samples count in the outermost ring and the last slab).
-  const double c = std::min(t, 1.0), c_lo = std::min(t_lo, 1.0), c_hi = std::min(t_hi, 1.0);
+  const double c_lo = std::min(t_lo, 1.0), c_hi = std::min(t_hi, 1.0);
   const int ri = std::min(rings_ - 1, int(c_lo * rings_));
-  const std::uint32_t rk = radial_(c);
-  if (ri != std::min(rings_ - 1, int(c_hi * rings_)) || !radial_.holds(rk, c_lo, c_hi)) return std::nullopt;
+  const std::uint32_t rk = radial_.common(c_lo, c_hi);
+  if (ri != std::min(rings_ - 1, int(c_hi * rings_)) || rk == SlabLocator::kNone) return std::nullopt;
   const double a_lo = a - phi_error_, a_hi = a + phi_error_;
   if (!(a_lo > 0 && a_hi < 1)) return std::nullopt;  // at the seam
   const int ai = std::min(columns_ - 1, int(a_lo * columns_));
-  const std::uint32_t ak = azimuth_(a);
-  if (ai != std::min(columns_ - 1, int(a_hi * columns_)) || !azimuth_.holds(ak, a_lo, a_hi)) return std::nullopt;
+  const std::uint32_t ak = azimuth_.common(a_lo, a_hi);
+  if (ai != std::min(columns_ - 1, int(a_hi * columns_)) || ak == SlabLocator::kNone) return std::nullopt;
   return Placement{false, std::uint32_t(ri * columns_ + ai), rk, ak};
 }
 
@@ -252,8 +260,9 @@ struct Tally {
   }
   // The same for samples in double (sample_block_double): their directions are the Samples' exactly.
   void add(const CapBinner& b, std::size_t n, Block& d) {
+    // v - v is 0 for a finite v and NaN otherwise: one comparison per sample, and the loop vectorises.
     for (std::size_t i = 0; i < n; ++i)
-      d.finite[i] = std::isfinite(d.x[i]) && std::isfinite(d.y[i]) && std::isfinite(d.z[i]) && std::isfinite(d.pdf[i]);
+      d.finite[i] = (d.x[i] - d.x[i]) + (d.y[i] - d.y[i]) + (d.z[i] - d.z[i]) + (d.pdf[i] - d.pdf[i]) == 0;
     count(b, n, d, [&](std::size_t i) { return Vec3L(d.x[i], d.y[i], d.z[i]); });
   }
 

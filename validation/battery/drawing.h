@@ -93,6 +93,21 @@ class SlabLocator {
   bool holds(std::uint32_t k, double lo, double hi) const {
     return (k == 0 || x_[k - 1] < lo) && (k == last_ || hi <= x_[k]);
   }
+  // The slab of every v in [lo, hi] (lo <= hi), or kNone when they are not all in one slab. Where lo and hi share a
+  // bucket with at most one node, the bucket decides (one comparison with its node).
+  static constexpr std::uint32_t kNone = ~std::uint32_t(0);
+  std::uint32_t common(double lo, double hi) const {
+    if (lo >= 0 && hi < 1) {
+      const int j = int(lo * kBuckets);
+      const std::uint32_t k = first_[j];
+      if (int(hi * kBuckets) == j && first_[j + 1] - k <= 1) {
+        const bool above_lo = x_[k] < lo, above_hi = x_[k] < hi;  // x_[k] = +inf past the last node
+        return above_lo == above_hi ? std::min(last_, k + std::uint32_t(above_lo)) : kNone;
+      }
+    }
+    const std::uint32_t k = (*this)(lo);
+    return holds(k, lo, hi) ? k : kNone;
+  }
   std::size_t slabs() const { return last_ + 1; }
 
  private:

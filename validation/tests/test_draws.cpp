@@ -88,6 +88,35 @@ TEST(KsFromSlabCounts, GiveTheSortedSamplesCountAtEveryNode) {
   }
 }
 
+// common(lo, hi), which the fast placement takes as the slab of a coordinate within its error bound, is the slab of
+// both ends where they share one and kNone where they do not: on clustered nodes (many in one bucket of the lookup
+// table, or none), uniform ones (a node on every other bucket's edge), ranges from a point to 10^-6 wide, ranges
+// with an end on a node, a double beside one or beyond [0, 1].
+TEST(SlabLocator, CommonSlabOfARangeIsTheSlabOfBothEndsOrNone) {
+  std::vector<Real> uniform(1025);
+  for (std::size_t k = 0; k < uniform.size(); ++k) uniform[k] = Real(k) / 1024;
+  for (const std::vector<Real>& x : {clustered_nodes(1024), clustered_nodes(37), uniform}) {
+    const SlabLocator slab(x);
+    std::mt19937_64 g(5);
+    std::uniform_real_distribution<double> unit(-0.01, 1.01);
+    std::uniform_int_distribution<std::size_t> node(0, x.size() - 1);
+    std::size_t common = 0, none = 0;
+    auto check = [&](double lo, double hi) {
+      const std::uint32_t expected = slab(lo) == slab(hi) ? slab(lo) : SlabLocator::kNone;
+      ASSERT_EQ(slab.common(lo, hi), expected) << lo << " " << hi << " of " << x.size() << " nodes";
+      ++(expected == SlabLocator::kNone ? none : common);
+    };
+    for (int i = 0; i < 200000; ++i) {
+      const double width = std::ldexp(1.0, -20 - int(g() % 34)) * (i % 7 == 0 ? 0 : 1);
+      const double xk = double(x[node(g)]), v = i % 2 ? unit(g) : xk;
+      for (double lo : {v, v - width, std::nextafter(v, -2.0), std::nextafter(v, 2.0)}) check(lo, lo + width);
+    }
+    check(-0.0, 0.0), check(1, 1), check(0.5, 1), check(-1, 0), check(1, 2);
+    EXPECT_GT(common, 100000u);
+    EXPECT_GT(none, 10000u);
+  }
+}
+
 TEST(CapBinner, AzimuthPolynomialIsWithinItsStatedError) {
   double worst = 0;
   for (int i = 0; i <= 1 << 22; ++i) {
