@@ -16,6 +16,13 @@
 #include <numbers>
 #include <type_traits>
 
+// For the small helpers of every view, which GCC otherwise leaves as calls on the one-sample-per-light path.
+#if defined(__GNUC__)
+#define WARPCHECK_ALWAYS_INLINE [[gnu::always_inline]] inline
+#else
+#define WARPCHECK_ALWAYS_INLINE inline
+#endif
+
 namespace warpcheck {
 
 template <class T> using Vec2 = Eigen::Matrix<T, 2, 1>;
@@ -106,7 +113,7 @@ template <class T> bool all_finite(const Vec3<T>& v) {
 template <class T> struct Frame {
   Vec3<T> x, y, z;
 
-  static Frame from_z(const Vec3<T>& n) {
+  WARPCHECK_ALWAYS_INLINE static Frame from_z(const Vec3<T>& n) {
     const T sign = std::copysign(T(1), n.z());
     const T a = T(-1) / (sign + n.z());
     const T b = n.x() * n.y() * a;
@@ -359,10 +366,16 @@ template <class T> Vec3<T> ldexp(const Vec3<T>& v, int e) {
   return Vec3<T>(std::ldexp(v.x(), e), std::ldexp(v.y(), e), std::ldexp(v.z(), e));
 }
 
+// max_i |v_i|: Eigen's cwiseAbs().maxCoeff() in its order, max(|x|, max(|y|, |z|)), so the same value (NaN
+// included), but inline where GCC leaves Eigen's reduction as a call.
+template <class T> WARPCHECK_ALWAYS_INLINE T max_abs(const Vec3<T>& v) {
+  return std::max(std::abs(v.x()), std::max(std::abs(v.y()), std::abs(v.z())));
+}
+
 // |v| without overflow or underflow: m sqrt((x s)^2 + (y s)^2 + (z s)^2), m = max |v_i|, s = 1 / m (Eigen's
 // stableNorm of a vector taken as one block, its special cases included). Eigen's own stableNorm splits a 3-vector
 // into blocks by its address (alignment), which changes the rounding; this one does not depend on where v lies.
-template <class T> T stable_norm(const Vec3<T>& v) {
+template <class T> WARPCHECK_ALWAYS_INLINE T stable_norm(const Vec3<T>& v) {
   const T m = std::max(std::max(std::abs(v.x()), std::abs(v.y())), std::abs(v.z()));
   if (m == T(0)) return T(0);
   T inv = T(1) / m, scale = m;
@@ -386,7 +399,7 @@ template <class T> T near_unit_renormalization_factor(T n2) {
 }
 
 // Normalises a shading normal; returns false for zero, subnormal-length or non-finite normals.
-template <class T> bool normalize_normal(const Vec3<T>& n, Vec3<T>& out) {
+template <class T> WARPCHECK_ALWAYS_INLINE bool normalize_normal(const Vec3<T>& n, Vec3<T>& out) {
   if (!all_finite(n)) return false;
   const T len = stable_norm(n);
   if (!(len > std::numeric_limits<T>::min()) || !std::isfinite(len)) return false;

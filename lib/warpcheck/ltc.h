@@ -77,7 +77,7 @@ template <class T> PolygonLightGeometry<T> ltc_transformed_polygon(const Polygon
 // check_polygon's squared area (a product of four coordinates) under- or overflows and the light is refused.
 template <class T> PolygonLightGeometry<T> ltc_unit_magnitude(PolygonLightGeometry<T> tg) {
   T magnitude = 0;
-  for (int i = 0; i < tg.light.count; ++i) magnitude = std::max(magnitude, tg.light.vertices[i].cwiseAbs().maxCoeff());
+  for (int i = 0; i < tg.light.count; ++i) magnitude = std::max(magnitude, max_abs(tg.light.vertices[i]));
   if (!(magnitude > T(0)) || !std::isfinite(magnitude)) return tg;
   const int e = std::ilogb(magnitude);
   for (int i = 0; i < tg.light.count; ++i) tg.light.vertices[i] = ldexp(tg.light.vertices[i], -e);
@@ -103,21 +103,26 @@ template <class T> T ltc_vertex_rounding(const Mat3<T>& m, const Mat3<T>& m_inv)
   return kPolygonVertexRounding<T> + T(3) * std::sqrt(T(3)) * eps * (m.norm() * m_inv.norm());
 }
 
-template <class T> LtcPolygonView<T> make_ltc_polygon_view(const LtcPolygonGeometry<T>& g) {
-  LtcPolygonView<T> v;
+template <class T> NoSample fill_ltc_polygon_view(const LtcPolygonGeometry<T>& g, LtcPolygonView<T>& v) {
   const PolygonView<T> pv = make_polygon_view(g.polygon);
-  if (!pv.valid()) return v.reason = pv.reason, v;
-  if (!g.m.allFinite()) return v.reason = NoSample::kNonFinite, v;
+  if (!pv.valid()) return pv.reason;
+  if (!g.m.allFinite()) return NoSample::kNonFinite;
   v.frame = pv.frame;
   v.planes = polygon_inward_planes(g.polygon, pv, v.inward.data());
   v.m = ltc_unit_scale(g.m);
   // |M| > 0 (Sec. 4.1). A singular or reflecting M has no LTC; an M whose inverse overflows neither.
-  if (!ltc_inverse(v.m, &v.m_inv, &v.det)) return v.reason = NoSample::kInvalidGeometry, v;
+  if (!ltc_inverse(v.m, &v.m_inv, &v.det)) return NoSample::kInvalidGeometry;
   v.det_inv = T(1) / v.det;
   v.transformed = make_polygon_projected_view(ltc_unit_magnitude(ltc_transformed_polygon(pv, v.m_inv)),
                                               ltc_vertex_rounding(v.m, v.m_inv));
-  if (!v.transformed.valid()) return v.reason = v.transformed.reason, v;
+  if (!v.transformed.valid()) return v.transformed.reason;
   v.integral = v.transformed.projected_solid_angle / kPi<T>;
+  return NoSample::kNone;
+}
+
+template <class T> LtcPolygonView<T> make_ltc_polygon_view(const LtcPolygonGeometry<T>& g) {
+  LtcPolygonView<T> v;  // filled in place: no copy of the view on return
+  v.reason = fill_ltc_polygon_view(g, v);
   return v;
 }
 

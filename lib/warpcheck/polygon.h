@@ -105,7 +105,7 @@ template <class T> int cross2_sign(const Vec2<T>& a, const Vec2<T>& b) { return 
 
 // Normalises without overflow or underflow (scales by the largest entry first); zero stays zero.
 template <class T> Vec3<T> safe_normalized(const Vec3<T>& v) {
-  const T m = v.cwiseAbs().maxCoeff();
+  const T m = max_abs(v);
   if (!(m > T(0)) || !std::isfinite(m)) return Vec3<T>::Zero();
   const Vec3<T> s = v / m;
   return s / s.norm();
@@ -135,7 +135,7 @@ template <class T> T polygon_planarity_tolerance(T width, T magnitude) {
 // grid), and its ends' rounding err scaled alike. False when no longer than err: no direction in the plane.
 template <class T> bool edge_in_plane(const Vec3<T>& e, T err, const Vec3<T>& nhat, Vec3<T>& scaled, T& scaled_err) {
   int scale = 0;
-  std::frexp(e.cwiseAbs().maxCoeff(), &scale);
+  std::frexp(max_abs(e), &scale);
   const Vec3<T> es = ldexp(e, -scale);
   scaled = es - nhat.dot(es) * nhat;
   scaled_err = scale_by_power_of_two(err, -scale);
@@ -173,7 +173,7 @@ template <class T> Verdict check_vertices(const PolygonLight<T>& p) {
 template <class T> Verdict check_plane(const PolygonLight<T>& p, Vec3<T>& area2, Vec3<T>& nhat) {
   T diameter = 0, magnitude = 0;
   for (int i = 0; i < p.count; ++i) {
-    magnitude = std::max(magnitude, p.vertices[i].cwiseAbs().maxCoeff());
+    magnitude = std::max(magnitude, max_abs(p.vertices[i]));
     for (int j = i + 1; j < p.count; ++j) diameter = std::max(diameter, (p.vertices[i] - p.vertices[j]).norm());
   }
   area2 = polygon_area_vector(p);
@@ -198,7 +198,7 @@ template <class T> bool is_spike(const Vec3<T>& a, const Vec3<T>& b, T s) {
 // with nhat and add up to one revolution. A reflex turn is forgiven only within the vertices' rounding: s is off by
 // at most |a| err_b + |b| err_a + err_a err_b.
 template <class T> Verdict check_convexity(const PolygonLight<T>& p, const Vec3<T>& nhat, T vertex_rounding) {
-  auto rounding = [&](int k) { return vertex_rounding * p.vertices[(k + p.count) % p.count].cwiseAbs().maxCoeff(); };
+  auto rounding = [&](int k) { return vertex_rounding * max_abs(p.vertices[(k + p.count) % p.count]); };
   for (int i = 0; i < p.count; ++i) {
     const Vec3<T> a = p.vertices[i] - p.vertices[(i + p.count - 1) % p.count];
     const Vec3<T> b = p.vertices[(i + 1) % p.count] - p.vertices[i];
@@ -259,7 +259,7 @@ template <class T> NoSample check_polygon(const PolygonLight<T>& p, std::string*
 template <class T> void polygon_edges_in_plane(const PolygonLight<T>& p, const Vec3<T>& nh, T vertex_rounding,
                                                std::array<Vec3<T>, kMaxPolygonVertices>& edge,
                                                std::array<bool, kMaxPolygonVertices>& has_direction) {
-  auto rounding = [&](int k) { return vertex_rounding * p.vertices[k % p.count].cwiseAbs().maxCoeff(); };
+  auto rounding = [&](int k) { return vertex_rounding * max_abs(p.vertices[k % p.count]); };
   for (int j = 0; j < p.count; ++j) {
     T err;
     const Vec3<T> e = p.vertices[(j + 1) % p.count] - p.vertices[j];
@@ -275,9 +275,22 @@ template <class T> struct PreparedPolygonLight {
   T vertex_rounding = kPolygonVertexRounding<T>;
   NoSample reason = NoSample::kInvalidGeometry;
   Vec3<T> area2 = Vec3<T>::Zero();
+  Vec3<T> plane_normal = Vec3<T>::Zero();           // safe_normalized(area2)
   std::array<Vec3<T>, kMaxPolygonVertices> edge{};  // V_j+1 - V_j in the plane, scaled by a power of two
   std::array<bool, kMaxPolygonVertices> has_direction{};
+  // The light's extents: max_k |V_k - V_0|_inf, max_k |V_k|_inf, 2 max_k |V_k - V_0|
+  T extent = 0, magnitude = 0, diameter = 0;
 };
+
+// The light's extents as PreparedPolygonLight holds them.
+template <class T> void polygon_extents(const PolygonLight<T>& p, T& extent, T& magnitude, T& diameter) {
+  extent = magnitude = diameter = 0;
+  for (int i = 0; i < p.count; ++i) {
+    extent = std::max(extent, max_abs(Vec3<T>(p.vertices[i] - p.vertices[0])));
+    magnitude = std::max(magnitude, max_abs(p.vertices[i]));
+    diameter = std::max(diameter, T(2) * stable_norm(Vec3<T>(p.vertices[i] - p.vertices[0])));
+  }
+}
 
 template <class T>
 PreparedPolygonLight<T> prepare_polygon_light(const PolygonLight<T>& p, T vertex_rounding = kPolygonVertexRounding<T>) {
@@ -286,7 +299,9 @@ PreparedPolygonLight<T> prepare_polygon_light(const PolygonLight<T>& p, T vertex
   r.vertex_rounding = vertex_rounding;
   r.reason = polygon_check_detail::check_polygon_and_area(p, nullptr, vertex_rounding, r.area2);
   if (r.reason != NoSample::kNone) return r;
-  polygon_edges_in_plane(p, safe_normalized(r.area2), vertex_rounding, r.edge, r.has_direction);
+  r.plane_normal = safe_normalized(r.area2);
+  polygon_edges_in_plane(p, r.plane_normal, vertex_rounding, r.edge, r.has_direction);
+  polygon_extents(p, r.extent, r.magnitude, r.diameter);
   return r;
 }
 
@@ -347,59 +362,62 @@ template <class T> struct PolygonView {
 };
 
 // Validates the input and expresses the polygon in the shading frame; x in the light's plane gives kEdgeOn.
-template <class T>
-PolygonView<T> make_polygon_view(const PolygonLightGeometry<T>& g, T vertex_rounding = kPolygonVertexRounding<T>) {
-  PolygonView<T> v;
+template <class T> NoSample fill_polygon_view(const PolygonLightGeometry<T>& g, T vertex_rounding, PolygonView<T>& v) {
   v.vertex_rounding = vertex_rounding;
-  if (!all_finite(g.shading.position)) return v.reason = NoSample::kNonFinite, v;
-  if (!all_finite(g.shading.normal)) return v.reason = NoSample::kNonFinite, v;
+  if (!all_finite(g.shading.position)) return NoSample::kNonFinite;
+  if (!all_finite(g.shading.normal)) return NoSample::kNonFinite;
   Vec3<T> area2;
   const PreparedPolygonLight<T>* prep = v.prepared = matching_preparation(g, vertex_rounding);
   const NoSample checked =
       prep ? prep->reason : polygon_check_detail::check_polygon_and_area(g.light, nullptr, vertex_rounding, area2);
-  if (checked != NoSample::kNone) return v.reason = checked, v;
+  if (checked != NoSample::kNone) return checked;
   if (prep) area2 = prep->area2;
-  if (!normalize_normal(g.shading.normal, v.normal)) return v.reason = NoSample::kBadNormal, v;
+  if (!normalize_normal(g.shading.normal, v.normal)) return NoSample::kBadNormal;
   v.frame = Frame<T>::from_z(v.normal);
-  v.plane_normal = safe_normalized(area2);  // Newell's vector, as polygon_area_vector
+  v.plane_normal = prep ? prep->plane_normal : safe_normalized(area2);  // Newell's vector, as polygon_area_vector
+  const int n = g.light.count;
+  std::array<Vec3<T>, kMaxPolygonVertices> to_vertex;  // V_k - x
+  for (int i = 0; i < n; ++i) to_vertex[i] = g.light.vertices[i] - g.shading.position;
   // Signed distance from the centroid (averaging reduces the rounding of a single vertex).
   Vec3<T> centroid = Vec3<T>::Zero();
-  for (int i = 0; i < g.light.count; ++i) centroid += g.light.vertices[i] - g.shading.position;
-  centroid /= T(g.light.count);
-  if (!all_finite(centroid)) return v.reason = NoSample::kNonFinite, v;
+  for (int i = 0; i < n; ++i) centroid += to_vertex[i];
+  centroid /= T(n);
+  if (!all_finite(centroid)) return NoSample::kNonFinite;
   v.plane_distance = v.plane_normal.dot(centroid);
   // Edge-on up to rounding (8 eps of the reach): which side x is on is not determined.
+  const T eps = std::numeric_limits<T>::epsilon();
   T reach = 0;
-  for (int i = 0; i < g.light.count; ++i)
-    reach = std::max(reach, Vec3<T>(g.light.vertices[i] - g.shading.position).cwiseAbs().maxCoeff());
-  if (!(std::abs(v.plane_distance) > T(8) * std::numeric_limits<T>::epsilon() * reach))
-    return v.reason = NoSample::kEdgeOn, v;
+  for (int i = 0; i < n; ++i) reach = std::max(reach, max_abs(to_vertex[i]));
+  if (!(std::abs(v.plane_distance) > T(8) * eps * reach)) return NoSample::kEdgeOn;
   // Edge-on too when vertices lie on both sides of x beyond their rounding: no convex spherical polygon.
-  for (int i = 0; i < g.light.count; ++i) {
-    const T side = v.plane_normal.dot(Vec3<T>(g.light.vertices[i] - g.shading.position));
-    const T err =
-        vertex_rounding * g.light.vertices[i].cwiseAbs().maxCoeff() + T(8) * std::numeric_limits<T>::epsilon() * reach;
-    if ((v.plane_distance > T(0) ? -side : side) > err) return v.reason = NoSample::kEdgeOn, v;
-  }
   // Flattening: a light off its plane (within tolerance) is no convex spherical polygon from close by; beyond the
   // offsets' rounding its vertices are moved onto the plane through the centroid (check_polygon's turns agree).
-  const T eps = std::numeric_limits<T>::epsilon();
   T off = 0;
-  for (int i = 0; i < g.light.count; ++i) {
-    v.lift[i] = v.plane_normal.dot(Vec3<T>(g.light.vertices[i] - g.shading.position)) - v.plane_distance;
+  for (int i = 0; i < n; ++i) {
+    const T side = v.plane_normal.dot(to_vertex[i]);
+    const T err = vertex_rounding * max_abs(g.light.vertices[i]) + T(8) * eps * reach;
+    if ((v.plane_distance > T(0) ? -side : side) > err) return NoSample::kEdgeOn;
+    v.lift[i] = side - v.plane_distance;
     off = std::max(off, std::abs(v.lift[i]));
   }
   v.flattened = off > T(8) * eps * reach;
   if (!v.flattened) v.lift.fill(T(0));
-  v.local.count = g.light.count;
-  for (int i = 0; i < g.light.count; ++i) {
-    Vec3<T> l = v.frame.to_local(Vec3<T>(g.light.vertices[i] - g.shading.position - v.lift[i] * v.plane_normal));
+  v.local.count = n;
+  for (int i = 0; i < n; ++i) {
+    Vec3<T> l = v.frame.to_local(Vec3<T>(to_vertex[i] - v.lift[i] * v.plane_normal));
     // A vertex within rounding of the horizon is on it, and one within rounding of the zenith is at it.
-    if (std::abs(l.z()) <= T(8) * std::numeric_limits<T>::epsilon() * l.cwiseAbs().maxCoeff()) l.z() = T(0);
-    const T xy_rounding = T(8) * std::numeric_limits<T>::epsilon() * l.cwiseAbs().maxCoeff();
+    if (std::abs(l.z()) <= T(8) * eps * max_abs(l)) l.z() = T(0);
+    const T xy_rounding = T(8) * eps * max_abs(l);
     if (std::abs(l.x()) <= xy_rounding && std::abs(l.y()) <= xy_rounding) l.x() = l.y() = T(0);
     v.local.v[i] = l;
   }
+  return NoSample::kNone;
+}
+
+template <class T>
+PolygonView<T> make_polygon_view(const PolygonLightGeometry<T>& g, T vertex_rounding = kPolygonVertexRounding<T>) {
+  PolygonView<T> v;  // filled in place: no copy of the view on return
+  v.reason = fill_polygon_view(g, vertex_rounding, v);
   return v;
 }
 

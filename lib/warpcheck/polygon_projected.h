@@ -76,7 +76,7 @@ void edge_boundary_point(const EdgeEllipse<T>& e, const Vec3<T>& a, const Vec3<T
     const Vec2<T> axy(a.x(), a.y()), bxy(b.x(), b.y()), pxy(p.x(), p.y());
     const T behind = T(8) * std::numeric_limits<T>::epsilon() * (axy.norm() + bxy.norm()) * w.norm();
     if (pxy.dot(w) < -behind) p = axy.dot(w) >= bxy.dot(w) ? a : b;
-    const T m = p.cwiseAbs().maxCoeff();
+    const T m = max_abs(p);
     if (m > T(0) && std::isfinite(m)) {
       const Vec3<T> q = p / m;
       const T n2 = q.squaredNorm();
@@ -301,32 +301,67 @@ template <class T> struct PolygonProjectedView {
 
 namespace polygon_projected_detail {
 
-// Whether the clipped polygon winds around the zenith (azimuth increments sum to 2 pi): robust where the signs of
-// the n_z are noise.
-template <class T> bool winds_around_zenith(const LocalPolygon<T>& p) {
+// The sum of the clipped polygon's azimuth increments: 2 pi times its winding number about the zenith, up to
+// rounding far below pi (each increment is atan2 of kahan_cross2's exact sign).
+template <class T> T azimuth_increments(const LocalPolygon<T>& p) {
   T sum = 0;
   for (int j = 0; j < p.count; ++j) {
     const Vec2<T> a(p.v[j].x(), p.v[j].y()), b(p.v[(j + 1) % p.count].x(), p.v[(j + 1) % p.count].y());
     sum += std::atan2(kahan_cross2(a, b), a.dot(b));
   }
-  return sum > kPi<T>;
+  return sum;
+}
+
+// 2^e, exactly, at compile time (e within T's normal range).
+template <class T> constexpr T exact_power_of_two(int e) {
+  T p = 1;
+  for (; e > 0; --e) p *= 2;
+  for (; e < 0; ++e) p /= 2;
+  return p;
+}
+
+// Whether x y and x y + z w, for coordinates like c, neither under- nor overflow: c is 0 or within
+// [2^(e_min/2 + p), 2^(e_max/2 - 1)] (p: T's digits), so products, their exact errors and kahan_det's result are
+// multiples of 2^(e_min - 1) below T's largest value.
+template <class T> bool products_stay_normal(T c) {
+  using limits = std::numeric_limits<T>;
+  constexpr T lo = exact_power_of_two<T>(limits::min_exponent / 2 + limits::digits);
+  constexpr T hi = exact_power_of_two<T>(limits::max_exponent / 2 - 1);
+  return c == T(0) || (std::abs(c) >= lo && std::abs(c) <= hi);
+}
+
+// Whether the clipped polygon winds around the zenith (its azimuth increments sum to 2 pi): robust where the signs
+// of the n_z are noise. Where no product under- or overflows, each increment atan2(a x b, a . b) has kahan_cross2's
+// exact sign and an error of a few ulps, so the sum is 2 pi times the winding number up to far less than pi; that
+// number is then counted exactly, as signed crossings of the ray y = 0, x > 0 (Sunday 2001). Elsewhere, and where an
+// edge has a x b = 0 and a . b <= 0 (an increment of +-pi by the sign of a zero), the sum decides.
+template <class T> bool winds_around_zenith(const LocalPolygon<T>& p) {
+  int winding = 0;
+  for (int j = 0; j < p.count; ++j) {
+    const Vec3<T>&a = p.v[j], &b = p.v[(j + 1) % p.count];
+    if (!products_stay_normal(a.x()) || !products_stay_normal(a.y())) return azimuth_increments(p) > kPi<T>;
+    const int side = det_sign(a.x(), a.y(), b.x(), b.y());
+    if (side == 0 && !(a.x() * b.x() + a.y() * b.y() > T(0))) return azimuth_increments(p) > kPi<T>;
+    if (a.y() <= T(0) && b.y() > T(0) && side > 0) ++winding;
+    if (b.y() <= T(0) && a.y() > T(0) && side < 0) --winding;
+  }
+  return winding > 0;
 }
 
 // Whether the light is resolved by its local coordinates: not below 64 eps of the coordinates' scale, in extent or
 // in its image's width D |plane_distance| / d (d bounded below by |plane_distance| and the nearest vertex less D).
+// The light's extents are its preparation's where it has one.
 template <class T> bool resolved_by_coordinates(const PolygonLightGeometry<T>& g, const PolygonView<T>& pv) {
-  T extent = 0, scale = 0;
-  for (int i = 0; i < g.light.count; ++i) {
-    extent = std::max(extent, Vec3<T>(g.light.vertices[i] - g.light.vertices[0]).cwiseAbs().maxCoeff());
-    scale = std::max(scale, g.light.vertices[i].cwiseAbs().maxCoeff());
-  }
-  scale += g.shading.position.cwiseAbs().maxCoeff();
+  T extent, scale, diameter;
+  if (pv.prepared)
+    extent = pv.prepared->extent, scale = pv.prepared->magnitude, diameter = pv.prepared->diameter;
+  else
+    polygon_extents(g.light, extent, scale, diameter);
+  scale += max_abs(g.shading.position);
   if (!(extent > T(64) * std::numeric_limits<T>::epsilon() * scale)) return false;
-  T diameter = 0, nearest = std::numeric_limits<T>::infinity();
-  for (int i = 0; i < g.light.count; ++i) {
-    diameter = std::max(diameter, T(2) * stable_norm(Vec3<T>(g.light.vertices[i] - g.light.vertices[0])));
+  T nearest = std::numeric_limits<T>::infinity();
+  for (int i = 0; i < g.light.count; ++i)
     nearest = std::min(nearest, stable_norm(Vec3<T>(g.light.vertices[i] - g.shading.position)));
-  }
   const T h = std::abs(pv.plane_distance), d = std::max(h, nearest - diameter);
   return diameter * (h / d) > T(64) * std::numeric_limits<T>::epsilon() * scale;
 }
@@ -429,14 +464,12 @@ template <class T, bool kBiased> bool decentral_sectors(PolygonProjectedView<T>&
 
 // The per-light precomputation: the clipped polygon in the (flipped) shading frame (Sec. 3.1), its sectors (Fig. 3)
 // and A_Sigma. vertex_rounding: as for check_polygon (polygon.h).
-template <class T, bool kBiased = false>
-PolygonProjectedView<T> make_polygon_projected_view(const PolygonLightGeometry<T>& g,
-                                                    T vertex_rounding = kPolygonVertexRounding<T>) {
+template <class T, bool kBiased>
+NoSample fill_polygon_projected_view(const PolygonLightGeometry<T>& g, T vertex_rounding, PolygonProjectedView<T>& v) {
   using namespace polygon_projected_detail;
-  PolygonProjectedView<T> v;
   const PolygonView<T> pv = make_polygon_view(g, vertex_rounding);
-  if (!pv.valid()) return v.reason = pv.reason, v;
-  if (!resolved_by_coordinates(g, pv)) return v.reason = NoSample::kTooSmall, v;
+  if (!pv.valid()) return pv.reason;
+  if (!resolved_by_coordinates(g, pv)) return NoSample::kTooSmall;
   v.frame = pv.frame;
   v.flip_y = pv.plane_distance < T(0);
   const int n = polygon_inward_planes(g, pv, v.inward.data());
@@ -449,9 +482,9 @@ PolygonProjectedView<T> make_polygon_projected_view(const PolygonLightGeometry<T
   const int m = v.clipped.count;
   bool above = false;
   for (int i = 0; i < m; ++i) above = above || v.clipped.v[i].z() > T(0);
-  if (m < 3 || !above) return v.reason = NoSample::kBelowHorizon, v;
+  if (m < 3 || !above) return NoSample::kBelowHorizon;
   const ClippedEdges<T> edges = classify_edges(v);
-  if (!edges.any_positive) return v.reason = NoSample::kTooSmall, v;  // no projected area representable
+  if (!edges.any_positive) return NoSample::kTooSmall;  // no projected area representable
   // A vertex at the zenith: the central decomposition is exact, and an n_z < 0 elsewhere is noise.
   bool zenith_vertex = false;
   for (int i = 0; i < m; ++i)
@@ -460,13 +493,20 @@ PolygonProjectedView<T> make_polygon_projected_view(const PolygonLightGeometry<T
   if (v.central)
     central_sectors<T, kBiased>(v, edges);
   else if (!decentral_sectors<T, kBiased>(v, edges))
-    return v.reason = NoSample::kTooSmall, v;
+    return NoSample::kTooSmall;
   T total = 0;
   for (int k = 0; k < v.sector_count; ++k) total += v.sectors[k].area;
   // The density cos / A_Sigma must be representable too.
-  if (!(total > T(0)) || !std::isfinite(total) || !std::isfinite(T(1) / total))
-    return v.reason = NoSample::kTooSmall, v;
+  if (!(total > T(0)) || !std::isfinite(total) || !std::isfinite(T(1) / total)) return NoSample::kTooSmall;
   v.projected_solid_angle = total;
+  return NoSample::kNone;
+}
+
+template <class T, bool kBiased = false>
+PolygonProjectedView<T> make_polygon_projected_view(const PolygonLightGeometry<T>& g,
+                                                    T vertex_rounding = kPolygonVertexRounding<T>) {
+  PolygonProjectedView<T> v;  // filled in place: no copy of the view on return
+  v.reason = fill_polygon_projected_view<T, kBiased>(g, vertex_rounding, v);
   return v;
 }
 

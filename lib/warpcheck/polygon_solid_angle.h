@@ -149,26 +149,32 @@ template <class T> bool split_wide_fan_edges(PolygonFanView<T>& f, bool horizon_
 
 // The polygon's fan as seen from the shading point, clipped to the upper hemisphere or not. split_wide_edges
 // (Section 5's sampler): fan edges wider than 120 degrees get their midpoints as vertices.
-template <class T>
-PolygonFanView<T> make_polygon_fan_view(const PolygonLightGeometry<T>& g, bool clipped, bool split_wide_edges = false) {
+template <class T> NoSample fill_polygon_fan_view(const PolygonLightGeometry<T>& g, bool clipped, bool split_wide_edges,
+                                                  PolygonFanView<T>& f) {
   using namespace polygon_fan_detail;
-  PolygonFanView<T> f;
   const PolygonView<T> pv = make_polygon_view(g);
-  if (!pv.valid()) return f.reason = pv.reason, f;
+  if (!pv.valid()) return pv.reason;
   f.plane_normal = pv.plane_normal;
   f.plane_distance = std::abs(pv.plane_distance);
   bool above = false;
   for (int i = 0; i < pv.local.count; ++i) above = above || pv.local.v[i].z() > T(0);
-  if (!above) return f.reason = NoSample::kBelowHorizon, f;
+  if (!above) return NoSample::kBelowHorizon;
   const bool reverse = pv.plane_distance < T(0);
   bool horizon_rooted = false;  // the clipped fan is rooted at a horizon edge's midpoint
   if (!clipped)
     unclipped_fan(g, pv, reverse, f);
   else if (!clipped_fan(pv, reverse, f, horizon_rooted))
-    return f.reason = NoSample::kBelowHorizon, f;
-  if (!fan_directions(f, false)) return f.reason = NoSample::kNonFinite, f;
+    return NoSample::kBelowHorizon;
+  if (!fan_directions(f, false)) return NoSample::kNonFinite;
   fan_cone(g, pv, reverse, clipped, f);
-  if (split_wide_edges && !split_wide_fan_edges(f, horizon_rooted)) return f.reason = NoSample::kNonFinite, f;
+  if (split_wide_edges && !split_wide_fan_edges(f, horizon_rooted)) return NoSample::kNonFinite;
+  return NoSample::kNone;
+}
+
+template <class T>
+PolygonFanView<T> make_polygon_fan_view(const PolygonLightGeometry<T>& g, bool clipped, bool split_wide_edges = false) {
+  PolygonFanView<T> f;  // filled in place: no copy of the view on return
+  f.reason = fill_polygon_fan_view(g, clipped, split_wide_edges, f);
   return f;
 }
 
@@ -192,9 +198,12 @@ template <class T> struct PolygonSolidAngleView {
 // for small, distant lights; Peters uses a Householder reflection, Supplement C).
 template <class T>
 PolygonSolidAngleView<T> make_polygon_solid_angle_view(const PolygonLightGeometry<T>& g, bool clipped = false) {
-  PolygonSolidAngleView<T> v;
-  v.fan = make_polygon_fan_view(g, clipped, /*split_wide_edges=*/true);
-  if (!v.fan.valid()) return v.reason = v.fan.reason, v;
+  // The fan built in place, not copied.
+  PolygonSolidAngleView<T> v{.fan = make_polygon_fan_view(g, clipped, /*split_wide_edges=*/true)};
+  if (!v.fan.valid()) {
+    v.reason = v.fan.reason;
+    return v;
+  }
   const auto& f = v.fan;
   for (int k = 1; k + 1 < f.count; ++k) {
     // As u_0 . ((e_k / |p_k|) x (e_{k+1} / |p_{k+1}|)): each factor scaled before the product, which underflows.
@@ -311,9 +320,11 @@ template <class T> T spherical_angle(const Vec3<T>& at, const Vec3<T>& b, const 
 }
 
 template <class T> ArvoFanView<T> make_arvo_fan_view(const PolygonLightGeometry<T>& g) {
-  ArvoFanView<T> v;
-  v.fan = make_polygon_fan_view(g, false);
-  if (!v.fan.valid()) return v.reason = v.fan.reason, v;
+  ArvoFanView<T> v{.fan = make_polygon_fan_view(g, false)};  // built in place, not copied
+  if (!v.fan.valid()) {
+    v.reason = v.fan.reason;
+    return v;
+  }
   const auto& u = v.fan.u;
   for (int k = 1; k + 1 < v.fan.count; ++k) {
     const T al = spherical_angle(u[0], u[k], u[k + 1]);
@@ -376,9 +387,11 @@ template <class T> struct TurkAreaView {
 };
 
 template <class T> TurkAreaView<T> make_turk_area_view(const PolygonLightGeometry<T>& g) {
-  TurkAreaView<T> v;
-  v.fan = make_polygon_fan_view(g, false);
-  if (!v.fan.valid()) return v.reason = v.fan.reason, v;
+  TurkAreaView<T> v{.fan = make_polygon_fan_view(g, false)};  // built in place, not copied
+  if (!v.fan.valid()) {
+    v.reason = v.fan.reason;
+    return v;
+  }
   for (int k = 1; k + 1 < v.fan.count; ++k) {
     v.area[k] = kahan_cross(v.fan.e[k], v.fan.e[k + 1]).norm() / T(2);
     v.total_area += v.area[k];

@@ -244,7 +244,7 @@ template <class T> int unit_scale_geometry(const SphereLightGeometry<T>& g, Sphe
   if (!all_finite(g.light.center) || !all_finite(g.shading.position) || !std::isfinite(r) || !(r > T(0))) return 0;
   const Vec3<T> d = g.light.center - g.shading.position;
   if (!all_finite(d)) return 0;  // the difference overflowed
-  const T m = d.cwiseAbs().maxCoeff();
+  const T m = max_abs(d);
   if (!(m > T(0))) return 0;  // x at the centre: inside the light
   int e = 0, er = 0;
   std::frexp(m, &e);
@@ -273,7 +273,7 @@ template <class T> void local_frame(ProjectedCapView<T>& p) {
   // Scaled to [1/2, 1) by a power of two first (exact), so that a subnormal horizontal part gives a unit x.
   if (p.w_dx > T(0)) {
     int ex = 0;
-    std::frexp(horizontal.cwiseAbs().maxCoeff(), &ex);
+    std::frexp(max_abs(horizontal), &ex);
     const Vec3<T> scaled = ldexp(horizontal, -ex);
     p.x = scaled / stable_norm(scaled);
   } else {
@@ -326,20 +326,19 @@ template <class T> void case3_geometry(ProjectedCapView<T>& p, T chord2) {
 }  // namespace projected_cap_detail
 
 // ComputeGeometry (Alg. 1) and the pieces (Alg. 2-4), once per light.
-template <class T> ProjectedCapView<T> make_projected_cap_view(const SphereLightGeometry<T>& g) {
+template <class T> NoSample fill_projected_cap_view(const SphereLightGeometry<T>& g, ProjectedCapView<T>& p) {
   using namespace projected_cap_detail;
-  ProjectedCapView<T> p;
   SphereLightGeometry<T> unit;
   const int scale_exponent = unit_scale_geometry(g, unit);
   p.sphere = make_sphere_view(unit);
-  if (!p.sphere.valid()) return p.reason = p.sphere.reason, p;
+  if (!p.sphere.valid()) return p.sphere.reason;
   p.sphere.distance = scale_by_power_of_two(p.sphere.distance, scale_exponent);  // |c - x| in the caller's units
   local_frame(p);
   p.r_y = std::sqrt(p.sphere.sin2_theta_max);
   p.v = p.sphere.cos_theta_max;
   p.r_x = p.h * p.r_y, p.r_z = p.w_dx * p.r_y, p.c_x = p.w_dx * p.v, p.c_z = p.h * p.v;
   const T h = p.h, ry = p.r_y, v = p.v;
-  if (h <= -ry) return p.reason = NoSample::kBelowHorizon, p;  // Case 4 (make_sphere_view catches it first)
+  if (h <= -ry) return NoSample::kBelowHorizon;  // Case 4 (make_sphere_view catches it first)
   // r_y^2 - h^2 = w_dx^2 - v^2, from the smaller operands; at the case boundary both cancel (inherent).
   const T chord2 = ry < v ? (ry - std::abs(h)) * (ry + std::abs(h)) : (p.w_dx - v) * (p.w_dx + v);
   if (h >= T(0)) p.cz_minus_rz = -chord2 / (h * v + p.w_dx * ry);
@@ -357,9 +356,15 @@ template <class T> ProjectedCapView<T> make_projected_cap_view(const SphereLight
     else
       case3_geometry(p, chord2);
   }
-  if (!(p.total > T(0)) || !std::isfinite(p.total)) return p.reason = NoSample::kTooSmall, p;
+  if (!(p.total > T(0)) || !std::isfinite(p.total)) return NoSample::kTooSmall;
   if constexpr (std::is_same_v<T, float>)
     p.quintic_piece_count = pieces<T, CutDiskInverse::kQuintic>(p, p.quintic_pieces);
+  return NoSample::kNone;
+}
+
+template <class T> ProjectedCapView<T> make_projected_cap_view(const SphereLightGeometry<T>& g) {
+  ProjectedCapView<T> p;  // filled in place: no copy of the view on return
+  p.reason = fill_projected_cap_view(g, p);
   return p;
 }
 

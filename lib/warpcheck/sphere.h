@@ -40,21 +40,20 @@ template <class T> struct SphereView {
   Cap<T> cap() const { return Cap<T>{frame.z, one_minus_cos_max}; }
 };
 
-template <class T> SphereView<T> make_sphere_view(const SphereLightGeometry<T>& g) {
-  SphereView<T> v;
+template <class T> NoSample fill_sphere_view(const SphereLightGeometry<T>& g, SphereView<T>& v) {
   const Vec3<T>& x = g.shading.position;
   const Vec3<T>& c = g.light.center;
   const T r = g.light.radius;
   if (!all_finite(x) || !all_finite(c) || !all_finite(g.shading.normal) || !std::isfinite(r))
-    return v.reason = NoSample::kNonFinite, v;
-  if (!normalize_normal(g.shading.normal, v.normal)) return v.reason = NoSample::kBadNormal, v;
-  if (r < T(0)) return v.reason = NoSample::kNegativeSize, v;
-  if (r == T(0)) return v.reason = NoSample::kZeroSize, v;
+    return NoSample::kNonFinite;
+  if (!normalize_normal(g.shading.normal, v.normal)) return NoSample::kBadNormal;
+  if (r < T(0)) return NoSample::kNegativeSize;
+  if (r == T(0)) return NoSample::kZeroSize;
   const Vec3<T> to_c = c - x;
-  if (!all_finite(to_c)) return v.reason = NoSample::kNonFinite, v;  // the difference overflowed
+  if (!all_finite(to_c)) return NoSample::kNonFinite;  // the difference overflowed
   const T d = stable_norm(to_c);
-  if (!std::isfinite(d)) return v.reason = NoSample::kNonFinite, v;
-  if (d <= r) return v.reason = NoSample::kInsideLight, v;
+  if (!std::isfinite(d)) return NoSample::kNonFinite;
+  if (d <= r) return NoSample::kInsideLight;
   v.distance = d;
   v.frame = Frame<T>::from_z(to_c / d);
   const T s = r / d;  // sin(theta_max) < 1
@@ -65,9 +64,15 @@ template <class T> SphereView<T> make_sphere_view(const SphereLightGeometry<T>& 
   v.one_minus_cos_max = v.sin2_theta_max / (T(1) + cos_max);
   // The density 1 / (2 pi (1 - cos)) must be representable (r / d ~ 4e-155 in double overflows it).
   if (!(v.one_minus_cos_max > T(0)) || !std::isfinite(T(1) / (kTwoPi<T> * v.one_minus_cos_max)))
-    return v.reason = NoSample::kTooSmall, v;
+    return NoSample::kTooSmall;
   // Entirely below the horizon: n.axis <= -sin(theta_max).
-  if (v.normal.dot(v.frame.z) <= -s) return v.reason = NoSample::kBelowHorizon, v;
+  if (v.normal.dot(v.frame.z) <= -s) return NoSample::kBelowHorizon;
+  return NoSample::kNone;
+}
+
+template <class T> SphereView<T> make_sphere_view(const SphereLightGeometry<T>& g) {
+  SphereView<T> v;  // filled in place: no copy of the view on return
+  v.reason = fill_sphere_view(g, v);
   return v;
 }
 

@@ -30,21 +30,21 @@ template <class T> struct SphericalRectangleView {
   bool valid() const { return reason == NoSample::kNone; }
 };
 
-template <class T> SphericalRectangleView<T> make_spherical_rectangle_view(const PolygonLightGeometry<T>& g) {
-  SphericalRectangleView<T> v;
+template <class T>
+NoSample fill_spherical_rectangle_view(const PolygonLightGeometry<T>& g, SphericalRectangleView<T>& v) {
   const PolygonView<T> pv = make_polygon_view(g);
-  if (!pv.valid()) return v.reason = pv.reason, v;
-  if (g.light.count != 4) return v.reason = NoSample::kInvalidGeometry, v;
+  if (!pv.valid()) return pv.reason;
+  if (g.light.count != 4) return NoSample::kInvalidGeometry;
   const Vec3<T> s = g.light.vertices[0];
   const Vec3<T> ex = g.light.vertices[1] - s, ey = g.light.vertices[3] - s;
   const T exl = ex.norm(), eyl = ey.norm();
   // A rectangle: orthogonal edges and V2 = V0 + ex + ey (to the precision of the input).
   const T tol = T(64) * std::sqrt(std::numeric_limits<T>::epsilon());
   if (std::abs(ex.dot(ey)) > tol * exl * eyl || (g.light.vertices[2] - s - ex - ey).norm() > tol * (exl + eyl))
-    return v.reason = NoSample::kInvalidGeometry, v;
+    return NoSample::kInvalidGeometry;
   bool above = false;
   for (int i = 0; i < 4; ++i) above = above || pv.local.v[i].z() > T(0);
-  if (!above) return v.reason = NoSample::kBelowHorizon, v;
+  if (!above) return NoSample::kBelowHorizon;
   v.o = g.shading.position;
   v.x = ex / exl, v.y = ey / eyl, v.z = v.x.cross(v.y);
   const Vec3<T> d = s - v.o;
@@ -61,12 +61,18 @@ template <class T> SphericalRectangleView<T> make_spherical_rectangle_view(const
   v.b0 = n0.z(), v.b1 = n2.z();
   v.k = kTwoPi<T> - g2 - g3;
   v.solid_angle = g0 + g1 - v.k;
-  if (!(v.solid_angle > T(0)) || !std::isfinite(v.solid_angle)) return v.reason = NoSample::kTooSmall, v;
+  if (!(v.solid_angle > T(0)) || !std::isfinite(v.solid_angle)) return NoSample::kTooSmall;
   // Support test in world space: inward normals of the rectangle's cone.
   std::array<Vec3<T>, 4> c;
   for (int i = 0; i < 4; ++i) c[i] = g.light.vertices[i] - g.shading.position;
   const T orient = pv.plane_distance > T(0) ? T(1) : T(-1);
   for (int i = 0; i < 4; ++i) v.inward[i] = orient * kahan_cross(c[i], c[(i + 1) % 4]);
+  return NoSample::kNone;
+}
+
+template <class T> SphericalRectangleView<T> make_spherical_rectangle_view(const PolygonLightGeometry<T>& g) {
+  SphericalRectangleView<T> v;  // filled in place: no copy of the view on return
+  v.reason = fill_spherical_rectangle_view(g, v);
   return v;
 }
 

@@ -267,12 +267,10 @@ template <class T> struct CosineCapView {
   }
 };
 
-template <class T> CosineCapView<T> make_cosine_cap_view(const Cap<T>& cap, const Vec3<T>& n) {
-  CosineCapView<T> v;
+template <class T> NoSample fill_cosine_cap_view(const Cap<T>& cap, const Vec3<T>& n, CosineCapView<T>& v) {
   v.cap = cap;
-  if (!all_finite(cap.axis) || !all_finite(n) || !std::isfinite(cap.one_minus_cos))
-    return v.reason = NoSample::kNonFinite, v;
-  if (!(cap.one_minus_cos > T(0))) return v.reason = NoSample::kZeroSize, v;
+  if (!all_finite(cap.axis) || !all_finite(n) || !std::isfinite(cap.one_minus_cos)) return NoSample::kNonFinite;
+  if (!(cap.one_minus_cos > T(0))) return NoSample::kZeroSize;
   const T omc = std::min(T(2), cap.one_minus_cos);
   v.cos_a = T(1) - omc;
   v.sin_a = std::sqrt(std::max(T(0), omc * (T(2) - omc)));
@@ -321,7 +319,13 @@ template <class T> CosineCapView<T> make_cosine_cap_view(const Cap<T>& cap, cons
     }
   }
   v.area = v.ellipse_only ? kPi<T> * v.sin_a * v.A : v.cdf(T(1));
-  if (!(v.area > T(0)) || !std::isfinite(v.area)) return v.reason = NoSample::kBelowHorizon, v;
+  if (!(v.area > T(0)) || !std::isfinite(v.area)) return NoSample::kBelowHorizon;
+  return NoSample::kNone;
+}
+
+template <class T> CosineCapView<T> make_cosine_cap_view(const Cap<T>& cap, const Vec3<T>& n) {
+  CosineCapView<T> v;  // filled in place: no copy of the view on return
+  v.reason = fill_cosine_cap_view(cap, n, v);
   return v;
 }
 
@@ -527,35 +531,40 @@ template <class T> struct SptdCapView {
   bool valid() const { return reason == NoSample::kNone; }
 };
 
-template <class T> SptdCapView<T> make_sptd_cap_view(const SptdCapGeometry<T>& g) {
-  SptdCapView<T> v;
+template <class T> NoSample fill_sptd_cap_view(const SptdCapGeometry<T>& g, SptdCapView<T>& v) {
   v.sptd = g.sptd;
   v.cap = g.cap;
   if (!all_finite(g.sptd.pivot) || !all_finite(g.sptd.base_axis) || !all_finite(g.cap.axis) ||
       !std::isfinite(g.cap.one_minus_cos))
-    return v.reason = NoSample::kNonFinite, v;
-  if (!valid_pivot(g.sptd.pivot)) return v.reason = NoSample::kInvalidGeometry, v;
-  if (g.cap.one_minus_cos < T(0)) return v.reason = NoSample::kNegativeSize, v;
-  if (!(g.cap.one_minus_cos > T(0))) return v.reason = NoSample::kZeroSize, v;
-  if (!normalize_normal(g.cap.axis, v.cap.axis)) return v.reason = NoSample::kInvalidGeometry, v;
+    return NoSample::kNonFinite;
+  if (!valid_pivot(g.sptd.pivot)) return NoSample::kInvalidGeometry;
+  if (g.cap.one_minus_cos < T(0)) return NoSample::kNegativeSize;
+  if (!(g.cap.one_minus_cos > T(0))) return NoSample::kZeroSize;
+  if (!normalize_normal(g.cap.axis, v.cap.axis)) return NoSample::kInvalidGeometry;
   if (g.sptd.base == SptdBase::kClampedCosine && !normalize_normal(g.sptd.base_axis, v.sptd.base_axis))
-    return v.reason = NoSample::kBadNormal, v;
+    return NoSample::kBadNormal;
   v.k = pivot_k(v.sptd.pivot);
-  if (!(v.k > T(0))) return v.reason = NoSample::kInvalidGeometry, v;
+  if (!(v.k > T(0))) return NoSample::kInvalidGeometry;
   v.image = v.sptd.base == SptdBase::kUniform
                 ? pivot_transform_cap(v.cap, v.sptd.pivot, v.k, &v.image_offset, &v.image_relative)
                 : pivot_transform_cap(v.cap, v.sptd.pivot, v.k);
-  if (!(v.image.one_minus_cos > T(0)) || !all_finite(v.image.axis)) return v.reason = NoSample::kTooSmall, v;
+  if (!(v.image.one_minus_cos > T(0)) || !all_finite(v.image.axis)) return NoSample::kTooSmall;
   if (v.sptd.base == SptdBase::kUniform) {
     v.base_integral = v.image.one_minus_cos / T(2);
   } else {
     v.cosine = make_cosine_cap_view(v.image, v.sptd.base_axis);
-    if (!v.cosine.valid()) return v.reason = v.cosine.reason, v;
+    if (!v.cosine.valid()) return v.cosine.reason;
     v.base_integral = v.cosine.area / kPi<T>;
   }
   // The normalised base density 1 / |g(C)| resp. 1 / area must be representable (as for sphere lights, sphere.h).
   const T norm = v.sptd.base == SptdBase::kUniform ? v.image.solid_angle() : v.cosine.area;
-  if (!std::isfinite(T(1) / norm)) return v.reason = NoSample::kTooSmall, v;
+  if (!std::isfinite(T(1) / norm)) return NoSample::kTooSmall;
+  return NoSample::kNone;
+}
+
+template <class T> SptdCapView<T> make_sptd_cap_view(const SptdCapGeometry<T>& g) {
+  SptdCapView<T> v;  // filled in place: no copy of the view on return
+  v.reason = fill_sptd_cap_view(g, v);
   return v;
 }
 

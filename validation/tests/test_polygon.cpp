@@ -1100,6 +1100,29 @@ TYPED_TEST(PolygonKernels, ALightNarrowerThanItsCoordinatesRoundingIsTooSmallFor
 // Sec. 3.1: a light around the zenith is central although an edge has n_z < 0 by rounding: a doubled vertex (an
 // octagon), a short edge whose line the coordinates do not place to the zenith's side (x 5e-9 beside a vertex),
 // and a vertex at the zenith (below); taken as decentral, their A_Sigma is ~1e-33 instead of 0.11 and 1.56.
+// Lattice polygons (many vertices on the axes, edges through the zenith) at scales where products stay normal and
+// where they under- or overflow: the crossing count and the azimuth increments' sum agree.
+TYPED_TEST(PolygonKernels, WindingAboutTheZenithIsTheVerdictOfTheAzimuthIncrementsSum) {
+  using T = TypeParam;
+  using limits = std::numeric_limits<T>;
+  std::mt19937_64 rng(41);
+  std::uniform_int_distribution<int> coordinate(-3, 3), count(3, kMaxClippedVertices);
+  const T scales[] = {T(1), T(0.375), std::ldexp(T(1), limits::min_exponent / 2),
+                      std::ldexp(T(1), limits::min_exponent), std::ldexp(T(1), limits::max_exponent / 2)};
+  int winding = 0, checked = 0;
+  for (const T scale : scales)
+    for (int trial = 0; trial < 20000; ++trial) {
+      LocalPolygon<T> p;
+      p.count = count(rng);
+      for (int k = 0; k < p.count; ++k) p.v[k] = Vec3<T>(T(coordinate(rng)), T(coordinate(rng)), T(1)) * scale;
+      const bool expected = polygon_projected_detail::azimuth_increments(p) > kPi<T>;
+      ASSERT_EQ(polygon_projected_detail::winds_around_zenith(p), expected) << "scale " << double(scale);
+      winding += expected, ++checked;
+    }
+  EXPECT_GT(winding, checked / 20);  // both verdicts are exercised
+  EXPECT_LT(winding, checked - checked / 20);
+}
+
 TEST(PolygonProjected, ProjectedSolidAngleMatchesLambertAroundTheZenithWithEdgesOfNoiseSign) {
   const PolygonLightGeometry<double> lights[] = {
       geom<double>({8.397054999316353, 3.442316484673952, 15.695498354587828},
