@@ -267,8 +267,9 @@ template <class T> void polygon_edges_in_plane(const PolygonLight<T>& p, const V
   }
 }
 
-// check_polygon's verdict, Newell's vector and the light's edges in its plane (edge_in_plane, as
-// polygon_inward_planes takes them). A renderer prepares each light once and points PolygonLightGeometry::prepared
+// check_polygon's verdict, Newell's vector and its unit normal, the light's edges in its plane (edge_in_plane, as
+// polygon_inward_planes takes them) and its extents (as the projected solid angle's resolved_by_coordinates takes
+// them). A renderer prepares each light once and points PolygonLightGeometry::prepared
 // at it; every view of that light then skips the work, and its results are the same bit for bit.
 template <class T> struct PreparedPolygonLight {
   PolygonLight<T> light;

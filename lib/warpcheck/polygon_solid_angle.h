@@ -320,7 +320,8 @@ template <class T> T spherical_angle(const Vec3<T>& at, const Vec3<T>& b, const 
 }
 
 template <class T> ArvoFanView<T> make_arvo_fan_view(const PolygonLightGeometry<T>& g) {
-  ArvoFanView<T> v{.fan = make_polygon_fan_view(g, false)};  // built in place, not copied
+  // The fan built in place, not copied.
+  ArvoFanView<T> v{.fan = make_polygon_fan_view(g, false)};
   if (!v.fan.valid()) {
     v.reason = v.fan.reason;
     return v;
@@ -387,7 +388,8 @@ template <class T> struct TurkAreaView {
 };
 
 template <class T> TurkAreaView<T> make_turk_area_view(const PolygonLightGeometry<T>& g) {
-  TurkAreaView<T> v{.fan = make_polygon_fan_view(g, false)};  // built in place, not copied
+  // The fan built in place, not copied.
+  TurkAreaView<T> v{.fan = make_polygon_fan_view(g, false)};
   if (!v.fan.valid()) {
     v.reason = v.fan.reason;
     return v;
