@@ -21,13 +21,9 @@ rev=$1
 kernels=${2:-sphere-solid-angle|sphere-projected-cap|polygon-solid-angle|polygon-projected-solid-angle|baseline-arvo-triangle|baseline-urena-rectangle}
 reps=${3:-8}
 flags=${CXXFLAGS:--O3 -DNDEBUG}
-root=$(cd "$(dirname "$0")/.." && pwd)
-work=$(mktemp -d)
-trap 'git -C "$root" worktree remove --force "$work/old" >/dev/null 2>&1 || true; rm -rf "$work"' EXIT
-git -C "$root" worktree add --detach "$work/old" "$rev" >/dev/null 2>&1 || {
-  echo "bench_ab: no revision $rev" >&2
-  exit 2
-}
+# shellcheck source=scripts/revision_tree.sh
+source "$(dirname "$0")/revision_tree.sh"
+revision_tree bench_ab "$rev"
 
 # One copy of the benchmark per side: names prefixed, float only, its main turned into a registration function.
 for side in old new; do

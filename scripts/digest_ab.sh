@@ -11,13 +11,9 @@ if [[ $# -ne 1 || $1 == -h || $1 == --help ]]; then
   exit $(($# == 1 ? 0 : 2))
 fi
 flags=${CXXFLAGS:--O3 -DNDEBUG}
-root=$(cd "$(dirname "$0")/.." && pwd)
-work=$(mktemp -d)
-trap 'git -C "$root" worktree remove --force "$work/old" >/dev/null 2>&1 || true; rm -rf "$work"' EXIT
-git -C "$root" worktree add --detach "$work/old" "$1" >/dev/null 2>&1 || {
-  echo "digest_ab: no revision $1" >&2
-  exit 2
-}
+# shellcheck source=scripts/revision_tree.sh
+source "$(dirname "$0")/revision_tree.sh"
+revision_tree digest_ab "$1"
 # shellcheck disable=SC2086  # flags is a list of words
 for side in old new; do
   lib=$([[ $side == old ]] && echo "$work/old/lib" || echo "$root/lib")

@@ -339,9 +339,10 @@ template <class T> bool winds_around_zenith(const LocalPolygon<T>& p) {
   int winding = 0;
   for (int j = 0; j < p.count; ++j) {
     const Vec3<T>&a = p.v[j], &b = p.v[(j + 1) % p.count];
-    if (!products_stay_normal(a.x()) || !products_stay_normal(a.y())) return azimuth_increments(p) > kPi<T>;
     const int side = det_sign(a.x(), a.y(), b.x(), b.y());
-    if (side == 0 && !(a.x() * b.x() + a.y() * b.y() > T(0))) return azimuth_increments(p) > kPi<T>;
+    if (!products_stay_normal(a.x()) || !products_stay_normal(a.y()) ||
+        (side == 0 && !(a.x() * b.x() + a.y() * b.y() > T(0))))
+      return azimuth_increments(p) > kPi<T>;
     if (a.y() <= T(0) && b.y() > T(0) && side > 0) ++winding;
     if (b.y() <= T(0) && a.y() > T(0) && side < 0) --winding;
   }
