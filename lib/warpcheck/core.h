@@ -366,17 +366,21 @@ template <class T> Vec3<T> ldexp(const Vec3<T>& v, int e) {
   return Vec3<T>(std::ldexp(v.x(), e), std::ldexp(v.y(), e), std::ldexp(v.z(), e));
 }
 
+// std::max(a, b), a < b ? b : a, returned by value: GCC keeps the temporaries of a nested std::max in memory (it
+// returns a reference) and selects among their addresses, a chain of stores and reloads.
+template <class T> WARPCHECK_ALWAYS_INLINE T larger(T a, T b) { return a < b ? b : a; }
+
 // max_i |v_i|: Eigen's cwiseAbs().maxCoeff() in its order, max(|x|, max(|y|, |z|)), so the same value (NaN
 // included), but inline where GCC leaves Eigen's reduction as a call.
 template <class T> WARPCHECK_ALWAYS_INLINE T max_abs(const Vec3<T>& v) {
-  return std::max(std::abs(v.x()), std::max(std::abs(v.y()), std::abs(v.z())));
+  return larger(std::abs(v.x()), larger(std::abs(v.y()), std::abs(v.z())));
 }
 
 // |v| without overflow or underflow: m sqrt((x s)^2 + (y s)^2 + (z s)^2), m = max |v_i|, s = 1 / m (Eigen's
 // stableNorm of a vector taken as one block, its special cases included). Eigen's own stableNorm splits a 3-vector
 // into blocks by its address (alignment), which changes the rounding; this one does not depend on where v lies.
 template <class T> WARPCHECK_ALWAYS_INLINE T stable_norm(const Vec3<T>& v) {
-  const T m = std::max(std::max(std::abs(v.x()), std::abs(v.y())), std::abs(v.z()));
+  const T m = larger(larger(std::abs(v.x()), std::abs(v.y())), std::abs(v.z()));
   if (m == T(0)) return T(0);
   T inv = T(1) / m, scale = m;
   if (inv > std::numeric_limits<T>::max())  // a subnormal m whose reciprocal overflows

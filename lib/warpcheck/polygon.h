@@ -405,7 +405,10 @@ template <class T> NoSample fill_polygon_view(const PolygonLightGeometry<T>& g, 
   if (!v.flattened) v.lift.fill(T(0));
   v.local.count = n;
   for (int i = 0; i < n; ++i) {
-    Vec3<T> l = v.frame.to_local(Vec3<T>(to_vertex[i] - v.lift[i] * v.plane_normal));
+    const Vec3<T>& a = to_vertex[i];  // a - lift n, written out: GCC left Eigen's expression as a call
+    const Vec3<T>& pn = v.plane_normal;
+    Vec3<T> l =
+        v.frame.to_local(Vec3<T>(a.x() - v.lift[i] * pn.x(), a.y() - v.lift[i] * pn.y(), a.z() - v.lift[i] * pn.z()));
     // A vertex within rounding of the horizon is on it, and one within rounding of the zenith is at it.
     if (std::abs(l.z()) <= T(8) * eps * max_abs(l)) l.z() = T(0);
     const T xy_rounding = T(8) * eps * max_abs(l);
