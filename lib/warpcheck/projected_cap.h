@@ -330,7 +330,7 @@ template <class T> NoSample fill_projected_cap_view(const SphereLightGeometry<T>
   using namespace projected_cap_detail;
   SphereLightGeometry<T> unit;
   const int scale_exponent = unit_scale_geometry(g, unit);
-  p.sphere = make_sphere_view(unit);
+  p.sphere.reason = fill_sphere_view(unit, p.sphere);  // in place, as make_sphere_view would return it
   if (!p.sphere.valid()) return p.sphere.reason;
   p.sphere.distance = scale_by_power_of_two(p.sphere.distance, scale_exponent);  // |c - x| in the caller's units
   local_frame(p);
