@@ -1097,6 +1097,40 @@ TYPED_TEST(PolygonKernels, ALightNarrowerThanItsCoordinatesRoundingIsTooSmallFor
   }
 }
 
+// The image-width test, decided first at a bound on d where it can be, gives the verdict of its formula at the
+// nearest vertex: D (h / d) > 64 eps scale, d = max(h, nearest - D). Squares seen nearly edge-on from 16 to 4096 times
+// their size away, h spread over a factor 16 around the bound, prepared and not.
+TYPED_TEST(PolygonKernels, ResolvedByCoordinatesIsTheImageWidthTestAtTheNearestVertex) {
+  using T = TypeParam;
+  const T eps = std::numeric_limits<T>::epsilon();
+  std::mt19937_64 rng(43);
+  std::uniform_real_distribution<double> U(0, 1);
+  int resolved = 0, checked = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    const T far = T(std::exp2(4 + 8 * U(rng))), s = T(0.5 + U(rng));
+    const T h = T(64) * eps * far * far / (T(2) * s) * T(std::exp2(4 * U(rng) - 2));
+    const PolygonLight<T> square{Vec3<T>(far - s, -s, h), Vec3<T>(far + s, -s, h), Vec3<T>(far + s, s, h),
+                                 Vec3<T>(far - s, s, h)};
+    const PreparedPolygonLight<T> prepared = prepare_polygon_light(square);
+    PolygonLightGeometry<T> g = geom<T>(Vec3<T>::Zero(), Vec3<T>(0, 0, 1), square);
+    if (trial % 2) g.prepared = &prepared;
+    const PolygonView<T> pv = make_polygon_view(g);
+    ASSERT_TRUE(pv.valid()) << to_string(pv.reason);
+    T extent, magnitude, diameter, nearest = std::numeric_limits<T>::infinity();
+    polygon_extents(square, extent, magnitude, diameter);
+    for (int i = 0; i < square.count; ++i) nearest = std::min(nearest, stable_norm(square.vertices[i]));
+    const T hh = std::abs(pv.plane_distance);
+    const bool expected =
+        extent > T(64) * eps * magnitude &&
+        polygon_projected_detail::image_wider_than_rounding(diameter, hh, std::max(hh, nearest - diameter), magnitude);
+    ASSERT_EQ(polygon_projected_detail::resolved_by_coordinates(g, pv), expected)
+        << "far " << double(far) << " h " << double(h) << " s " << double(s);
+    resolved += expected, ++checked;
+  }
+  EXPECT_GT(resolved, checked / 10);  // both verdicts are exercised
+  EXPECT_LT(resolved, checked - checked / 10);
+}
+
 // Sec. 3.1: a light around the zenith is central although an edge has n_z < 0 by rounding: a doubled vertex (an
 // octagon), a short edge whose line the coordinates do not place to the zenith's side (x 5e-9 beside a vertex),
 // and a vertex at the zenith (below); taken as decentral, their A_Sigma is ~1e-33 instead of 0.11 and 1.56.
