@@ -28,7 +28,7 @@ template <class T> bool ltc_inverse(const Mat3<T>& m, Mat3<T>* m_inv, T* det) {
   if (!m.allFinite()) return false;
   const Eigen::FullPivLU<Mat3<T>> lu(m);
   *det = lu.determinant();
-  if (!(*det > T(0)) || !std::isfinite(*det) || !std::isfinite(T(1) / *det)) return false;
+  if (!(*det > T(0)) || !std::isfinite(*det) || !has_finite_reciprocal(*det)) return false;
   *m_inv = lu.inverse();
   return m_inv->allFinite();
 }

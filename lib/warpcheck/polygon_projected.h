@@ -479,7 +479,7 @@ template <class T, bool kBiased> bool decentral_sectors(PolygonProjectedView<T>&
 template <class T, bool kBiased>
 NoSample fill_polygon_projected_view(const PolygonLightGeometry<T>& g, T vertex_rounding, PolygonProjectedView<T>& v) {
   using namespace polygon_projected_detail;
-  const PolygonView<T> pv = make_polygon_view(g, vertex_rounding);
+  PolygonView<T> pv = make_polygon_view(g, vertex_rounding);  // its local polygon flipped in place below
   if (!pv.valid()) return pv.reason;
   if (!resolved_by_coordinates(g, pv)) return NoSample::kTooSmall;
   v.frame = pv.frame;
@@ -487,10 +487,9 @@ NoSample fill_polygon_projected_view(const PolygonLightGeometry<T>& g, T vertex_
   const int n = polygon_inward_planes(g, pv, v.inward.data());
   v.inward[n] = pv.normal;
   v.planes = n + 1;
-  LocalPolygon<T> local = pv.local;
   if (v.flip_y)
-    for (int i = 0; i < local.count; ++i) local.v[i].y() = -local.v[i].y();
-  v.clipped = clip_to_upper_hemisphere(local);
+    for (int i = 0; i < pv.local.count; ++i) pv.local.v[i].y() = -pv.local.v[i].y();
+  v.clipped = clip_to_upper_hemisphere(pv.local);
   const int m = v.clipped.count;
   bool above = false;
   for (int i = 0; i < m; ++i) above = above || v.clipped.v[i].z() > T(0);
@@ -509,7 +508,7 @@ NoSample fill_polygon_projected_view(const PolygonLightGeometry<T>& g, T vertex_
   T total = 0;
   for (int k = 0; k < v.sector_count; ++k) total += v.sectors[k].area;
   // The density cos / A_Sigma must be representable too.
-  if (!(total > T(0)) || !std::isfinite(total) || !std::isfinite(T(1) / total)) return NoSample::kTooSmall;
+  if (!(total > T(0)) || !std::isfinite(total) || !has_finite_reciprocal(total)) return NoSample::kTooSmall;
   v.projected_solid_angle = total;
   return NoSample::kNone;
 }

@@ -219,7 +219,7 @@ PolygonSolidAngleView<T> make_polygon_solid_angle_view(const PolygonLightGeometr
     v.solid_angle += v.area[k];
   }
   // 1 / Omega must be representable too.
-  if (!(v.solid_angle > T(0)) || !std::isfinite(v.solid_angle) || !std::isfinite(T(1) / v.solid_angle))
+  if (!(v.solid_angle > T(0)) || !std::isfinite(v.solid_angle) || !has_finite_reciprocal(v.solid_angle))
     v.reason = NoSample::kTooSmall;
   return v;
 }

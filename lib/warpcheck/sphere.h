@@ -63,7 +63,7 @@ template <class T> NoSample fill_sphere_view(const SphereLightGeometry<T>& g, Sp
   // 1 - cos = sin^2 / (1 + cos): no cancellation for tiny cones.
   v.one_minus_cos_max = v.sin2_theta_max / (T(1) + cos_max);
   // The density 1 / (2 pi (1 - cos)) must be representable (r / d ~ 4e-155 in double overflows it).
-  if (!(v.one_minus_cos_max > T(0)) || !std::isfinite(T(1) / (kTwoPi<T> * v.one_minus_cos_max)))
+  if (!(v.one_minus_cos_max > T(0)) || !has_finite_reciprocal(kTwoPi<T> * v.one_minus_cos_max))
     return NoSample::kTooSmall;
   // Entirely below the horizon: n.axis <= -sin(theta_max).
   if (v.normal.dot(v.frame.z) <= -s) return NoSample::kBelowHorizon;

@@ -1,5 +1,6 @@
 // core.h's fused_multiply_add (the same bits as std::fma, on inputs that stress its two exact steps), sine and
-// cosine (as accurate as std::sin and std::cos), and stable_norm (accurate at every scale, the same at every address).
+// cosine (as accurate as std::sin and std::cos), stable_norm (accurate at every scale, the same at every address) and
+// has_finite_reciprocal (the division's overflow without it).
 #include <gtest/gtest.h>
 
 #include <boost/multiprecision/cpp_bin_float.hpp>
@@ -8,6 +9,7 @@
 #include <cmath>
 #include <cstdint>
 #include <random>
+#include <vector>
 
 #include "warpcheck/core.h"
 
@@ -192,6 +194,34 @@ TEST(StableNorm, DoesNotDependOnWhereTheVectorLies) {
   }
   EXPECT_EQ(ours, 0);
   EXPECT_GT(eigens, 0);
+}
+
+// has_finite_reciprocal(x) is std::isfinite(1 / x) for x >= 0 or NaN: at the 64 numbers on either side of the
+// threshold, at the special values, and at 10^5 numbers spread over every exponent.
+template <class T> void check_has_finite_reciprocal() {
+  using limits = std::numeric_limits<T>;
+  std::vector<T> xs = {T(0),          limits::denorm_min(), limits::min(),      T(1),
+                       limits::max(), limits::infinity(),   limits::quiet_NaN()};
+  T up = limits::min() / T(4), down = up;
+  for (int i = 0; i < 64; ++i, up = std::nextafter(up, T(1)), down = std::nextafter(down, T(0)))
+    xs.push_back(up), xs.push_back(down);
+  std::mt19937_64 rng(44);
+  std::uniform_real_distribution<double> mantissa(1, 2);
+  std::uniform_int_distribution<int> exponent(limits::min_exponent - limits::digits, limits::max_exponent - 1);
+  for (int i = 0; i < 100000; ++i) xs.push_back(std::ldexp(T(mantissa(rng)), exponent(rng)));
+  int finite = 0;
+  for (const T x : xs) {
+    ASSERT_EQ(has_finite_reciprocal(x), std::isfinite(T(1) / x)) << double(x);
+    finite += std::isfinite(T(1) / x);
+  }
+  EXPECT_GT(finite, 64);  // both answers occur next to the threshold
+  EXPECT_LT(finite, int(xs.size()) - 64);
+}
+
+TEST(HasFiniteReciprocal, IsWhetherTheDivisionOverflowsInFloatDoubleAndLongDouble) {
+  check_has_finite_reciprocal<float>();
+  check_has_finite_reciprocal<double>();
+  check_has_finite_reciprocal<long double>();
 }
 
 }  // namespace
