@@ -370,7 +370,7 @@ template <class T> Vec3<T> ldexp(const Vec3<T>& v, int e) {
 // returns a reference) and selects among their addresses, a chain of stores and reloads.
 template <class T> WARPCHECK_ALWAYS_INLINE T larger(T a, T b) { return a < b ? b : a; }
 
-// Whether 1 / x is finite, for x > 0 or NaN, without the division: 1 / x rounds to Inf exactly for x <= t =
+// Whether 1 / x is finite, for x >= 0 or NaN, without the division: 1 / x rounds to Inf exactly for x <= t =
 // 2^-max_exponent (min / 4 in every IEEE format). Near t the numbers are subnormal and more than t 2^-(digits + 1)
 // apart, so none lies between t and the overflow threshold t / (1 - 2^-(digits + 1)).
 template <class T> bool has_finite_reciprocal(T x) {
