@@ -113,8 +113,8 @@ template <class T> NoSample fill_ltc_polygon_view(const LtcPolygonGeometry<T>& g
   // |M| > 0 (Sec. 4.1). A singular or reflecting M has no LTC; an M whose inverse overflows neither.
   if (!ltc_inverse(v.m, &v.m_inv, &v.det)) return NoSample::kInvalidGeometry;
   v.det_inv = T(1) / v.det;
-  v.transformed = make_polygon_projected_view(ltc_unit_magnitude(ltc_transformed_polygon(pv, v.m_inv)),
-                                              ltc_vertex_rounding(v.m, v.m_inv));
+  v.transformed.reason = fill_polygon_projected_view<T, false>(  // in place, not copied
+      ltc_unit_magnitude(ltc_transformed_polygon(pv, v.m_inv)), ltc_vertex_rounding(v.m, v.m_inv), v.transformed);
   if (!v.transformed.valid()) return v.transformed.reason;
   v.integral = v.transformed.projected_solid_angle / kPi<T>;
   return NoSample::kNone;

@@ -552,13 +552,14 @@ template <class T> NoSample fill_sptd_cap_view(const SptdCapGeometry<T>& g, Sptd
   if (v.sptd.base == SptdBase::kUniform) {
     v.base_integral = v.image.one_minus_cos / T(2);
   } else {
-    v.cosine = make_cosine_cap_view(v.image, v.sptd.base_axis);
+    v.cosine.reason = fill_cosine_cap_view(v.image, v.sptd.base_axis, v.cosine);  // in place, not copied
     if (!v.cosine.valid()) return v.cosine.reason;
     v.base_integral = v.cosine.area / kPi<T>;
   }
-  // The normalised base density 1 / |g(C)| resp. 1 / area must be representable (as for sphere lights, sphere.h).
+  // The normalised base density 1 / |g(C)| resp. 1 / area must be representable (as for sphere lights, sphere.h);
+  // norm >= 0 here (the image's 1 - cos and a valid cosine view's area are positive).
   const T norm = v.sptd.base == SptdBase::kUniform ? v.image.solid_angle() : v.cosine.area;
-  if (!std::isfinite(T(1) / norm)) return NoSample::kTooSmall;
+  if (!has_finite_reciprocal(norm)) return NoSample::kTooSmall;
   return NoSample::kNone;
 }
 
