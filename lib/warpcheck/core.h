@@ -168,6 +168,42 @@ inline float cube_root_squared_for_float(float x) {
   return float(xr + (xr * d) * p);  // x (r + r d P(d))
 }
 
+// ---- Arctangents ----
+
+// atan2 evaluated in double for the float kernels, inline: glibc 2.36's atan2f is a call into atanf (about 16 ns here)
+// and misrounds about one argument in seven (docs/measurements.md). Octants reduce to t = lo / hi in [0, 1]; above
+// tan(pi/8), atan t = pi/4 + atan((lo - hi) / (lo + hi)); then atan t = t P(t^2), P of degree 10 with relative error
+// 3.5e-17 (scripts/fit_arctangent.py), by Estrin's scheme. Within 4 ulps of double, so rounded to float it is the
+// correctly rounded float but within 2^-50 of a midpoint (test: Atan2InDouble.*). Subnormal t is still one
+// rounding (of lo / hi, then t P). Where hi is 0, Inf, NaN or above 2^1000 (lo + hi could overflow): std::atan2.
+inline double atan2_in_double(double y, double x) {
+  const double ax = std::abs(x), ay = std::abs(y);
+  const bool steep = ax < ay;
+  const double hi = steep ? ay : ax, lo = steep ? ax : ay;
+  if (!(hi > 0 && hi <= 0x1p1000)) return std::atan2(y, x);  // a NaN lo gives NaN below
+  const bool upper = lo > 0.41421356237309504880 * hi;       // t > tan(pi/8)
+  const double t = upper ? (lo - hi) / (lo + hi) : lo / hi;
+  constexpr double c0 = 0.99999999999999996532, c1 = -0.33333333333328438572, c2 = 0.19999999998855110134,
+                   c3 = -0.14285714180976466830, c4 = 0.11111106180455945220, c5 = -0.090907730748084137897,
+                   c6 = 0.076899534963068577563, c7 = -0.066402339304294085887, c8 = 0.056883492268090104794,
+                   c9 = -0.043480522157164624777, c10 = 0.021135373157693245206;
+  const double s = t * t, s2 = s * s, s4 = s2 * s2, s8 = s4 * s4;
+  const double p =
+      (c0 + c1 * s) + s2 * (c2 + c3 * s) + s4 * ((c4 + c5 * s) + s2 * (c6 + c7 * s)) + s8 * ((c8 + c9 * s) + s2 * c10);
+  double r = t * p + (upper ? std::numbers::pi / 4 : 0.0);
+  if (steep) r = std::numbers::pi / 2 - r;
+  if (x < 0) r = std::numbers::pi - r;
+  return std::copysign(r, y);
+}
+
+// The kernels' atan2: a float kernel's by atan2_in_double, rounded once; double's and long double's by std::atan2.
+template <class T> T kernel_atan2(T y, T x) {
+  if constexpr (std::is_same_v<T, float>)
+    return float(atan2_in_double(y, x));
+  else
+    return std::atan2(y, x);
+}
+
 // ---- a b + c rounded once ----
 // std::fma everywhere except x87 long double, which has no FMA instruction: there glibc's fmal saves and restores
 // the floating-point environment (~200 ns a call). fused_multiply_add gives the same bits from Dekker's exact

@@ -31,9 +31,13 @@ template <class T> T atan2_approx(T y, T x) {
   return std::signbit(y) ? -r : r;
 }
 
-template <class T, bool kBiased> T polygon_atan2(T y, T x) {
+// Eq. 1's arctangent in scalar A for a kernel of scalar T: the biased variant's approximation, else the kernels'
+// atan2 (kernel_atan2), for a float kernel also where it computes in double.
+template <class A, bool kBiased, class T = A> A polygon_atan2(A y, A x) {
   if constexpr (kBiased)
     return atan2_approx(y, x);
+  else if constexpr (std::is_same_v<T, float>)
+    return A(atan2_in_double(y, x));
   else
     return std::atan2(y, x);
 }
@@ -94,10 +98,10 @@ template <class T> EdgeEllipse<T> edge_ellipse(const Vec3<T>& n_unit) {
 }
 
 // Eq. 1 (homogeneous form): the ellipse's area in the sector from s0 to s1, given cross = s0 x s1.
-template <class T, bool kBiased = false>
+template <class T, bool kBiased = false, class Kernel = T>
 T ellipse_sector_area(const EdgeEllipse<T>& e, const Vec2<T>& s0, const Vec2<T>& s1, T cross) {
   const T a = std::abs(e.nz);
-  return a / T(2) * polygon_atan2<T, kBiased>(a * cross, e.form(s0, s1));
+  return a / T(2) * polygon_atan2<T, kBiased, Kernel>(a * cross, e.form(s0, s1));
 }
 
 // ---- Sectors ----
@@ -142,8 +146,8 @@ T area_between_ellipses(const ProjectedSector<T>& s, const Vec2<T>& a, const Vec
   using A = EllipseAreaScalar<T, kBiased>;
   const Vec2<A> aa = a.template cast<A>(), ba = b.template cast<A>();
   const A c = std::is_same_v<A, T> || cross == T(0) ? A(cross) : kahan_cross2(aa, ba);
-  return T(ellipse_sector_area<A, kBiased>(ellipse_cast<A>(s.outer), aa, ba, c) -
-           ellipse_sector_area<A, kBiased>(ellipse_cast<A>(s.inner), aa, ba, c));
+  return T(ellipse_sector_area<A, kBiased, T>(ellipse_cast<A>(s.outer), aa, ba, c) -
+           ellipse_sector_area<A, kBiased, T>(ellipse_cast<A>(s.inner), aa, ba, c));
 }
 
 // The area between the ellipses in the sector from s0 to w (the subtracted terms of Eq. 7).
@@ -307,7 +311,7 @@ template <class T> T azimuth_increments(const LocalPolygon<T>& p) {
   T sum = 0;
   for (int j = 0; j < p.count; ++j) {
     const Vec2<T> a(p.v[j].x(), p.v[j].y()), b(p.v[(j + 1) % p.count].x(), p.v[(j + 1) % p.count].y());
-    sum += std::atan2(kahan_cross2(a, b), a.dot(b));
+    sum += kernel_atan2(kahan_cross2(a, b), a.dot(b));
   }
   return sum;
 }

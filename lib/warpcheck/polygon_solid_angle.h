@@ -215,7 +215,7 @@ PolygonSolidAngleView<T> make_polygon_solid_angle_view(const PolygonLightGeometr
     v.g2[k] = dot < T(0) ? sum.squaredNorm() / T(2) : T(1) + dot;
     v.g1[k] = f.u[k + 1].dot(sum);
     const T denom = v.g1[k] + v.g2[k];
-    v.area[k] = std::max(T(0), T(2) * std::atan2(v.g0[k], denom));
+    v.area[k] = std::max(T(0), T(2) * kernel_atan2(v.g0[k], denom));
     v.solid_angle += v.area[k];
   }
   // 1 / Omega must be representable too.
@@ -316,7 +316,7 @@ template <class T> struct ArvoFanView {
 
 template <class T> T spherical_angle(const Vec3<T>& at, const Vec3<T>& b, const Vec3<T>& c) {
   const Vec3<T> nb = at.cross(b), nc = at.cross(c);
-  return std::atan2(nb.cross(nc).norm(), nb.dot(nc));
+  return kernel_atan2(nb.cross(nc).norm(), nb.dot(nc));
 }
 
 template <class T> ArvoFanView<T> make_arvo_fan_view(const PolygonLightGeometry<T>& g) {

@@ -1,6 +1,7 @@
 // core.h's fused_multiply_add (the same bits as std::fma, on inputs that stress its two exact steps), sine and
-// cosine (as accurate as std::sin and std::cos), stable_norm (accurate at every scale, the same at every address) and
-// has_finite_reciprocal (the division's overflow without it).
+// cosine (as accurate as std::sin and std::cos), stable_norm (accurate at every scale, the same at every address),
+// has_finite_reciprocal (the division's overflow without it), atan2_in_double (within 4 ulps; float results correctly
+// rounded) and kernel_atan2 (the library's in double and long double).
 #include <gtest/gtest.h>
 
 #include <boost/multiprecision/cpp_bin_float.hpp>
@@ -222,6 +223,66 @@ TEST(HasFiniteReciprocal, IsWhetherTheDivisionOverflowsInFloatDoubleAndLongDoubl
   check_has_finite_reciprocal<float>();
   check_has_finite_reciprocal<double>();
   check_has_finite_reciprocal<long double>();
+}
+
+// Error of got in ulps of double at the long-double reference (whose own error is 2^-11 of those).
+double double_ulps(double got, LD ref) {
+  const double r = std::abs(double(ref));
+  return double(std::abs(LD(got) - ref) / LD(std::nextafter(r, HUGE_VAL) - r));
+}
+
+// Pairs (y, x) over exponents in [-480, 480], near the diagonal and near tan(pi/8), where the reduction switches.
+std::vector<std::array<double, 2>> atan2_arguments(int n) {
+  std::mt19937_64 rng(20261206);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::uniform_int_distribution<int> e(-480, 480);
+  std::vector<std::array<double, 2>> out;
+  for (int i = 0; i < n; ++i) {
+    double x = std::ldexp(u(rng), e(rng)), y = std::ldexp(u(rng), e(rng));
+    if (i % 4 == 1) y = x * (1 + 1e-3 * u(rng));
+    if (i % 4 == 2) y = x * (0.41421356237309504880 + 1e-3 * u(rng));
+    if (i % 4 == 3) y = std::ldexp(u(rng), std::ilogb(x) + int(rng() % 61) - 30);
+    if (rng() & 1) std::swap(x, y);
+    out.push_back({y, x});
+  }
+  return out;
+}
+
+TEST(Atan2InDouble, IsWithinFourUlpsOfDoubleAndRoundsFloatArgumentsCorrectly) {
+  double worst = 0;
+  int misrounded = 0;
+  for (const auto& [y, x] : atan2_arguments(2000000)) {
+    worst = std::max(worst, double_ulps(atan2_in_double(y, x), std::atan2(LD(y), LD(x))));
+    const float fy = float(y), fx = float(x);
+    if (std::abs(fy) < 1e-30f || std::abs(fx) < 1e-30f || std::isinf(fy) || std::isinf(fx)) continue;
+    misrounded += kernel_atan2(fy, fx) != float(std::atan2(LD(fy), LD(fx)));
+  }
+  EXPECT_LE(worst, 4.0);
+  EXPECT_GT(worst, 0.5);  // the arguments reach the reduction's rounding: a bound that can fail
+  EXPECT_EQ(misrounded, 0);
+}
+
+TEST(Atan2InDouble, GivesTheLibrarysSignsOfZeroQuadrantsAndSpecialValues) {
+  const double inf = HUGE_VAL, nan = std::numeric_limits<double>::quiet_NaN(), big = std::numeric_limits<double>::max();
+  const double values[] = {0.0,       -0.0,     1.0,         -1.0, 3.5,  -0.25, 0x1p-1000, -0x1p-1070,
+                           0x1p-1074, 0x1p1000, -0x1.8p1023, big,  -big, inf,   -inf,      nan};
+  for (double y : values)
+    for (double x : values) {
+      const double got = atan2_in_double(y, x), want = std::atan2(y, x);
+      if (std::isnan(want)) {
+        EXPECT_TRUE(std::isnan(got)) << y << " " << x;
+        continue;
+      }
+      EXPECT_EQ(std::signbit(got), std::signbit(want)) << y << " " << x;
+      EXPECT_LE(double_ulps(got, std::atan2(LD(y), LD(x))), 4.0) << y << " " << x;
+    }
+}
+
+TEST(KernelAtan2, IsTheLibrarysInDoubleAndLongDouble) {
+  for (const auto& [y, x] : atan2_arguments(1000)) {
+    EXPECT_EQ(kernel_atan2(y, x), std::atan2(y, x));
+    EXPECT_EQ(kernel_atan2(LD(y), LD(x)), std::atan2(LD(y), LD(x)));
+  }
 }
 
 }  // namespace
