@@ -4,7 +4,11 @@
 P is mpmath's Chebyshev fit (near minimax) of atan(sqrt(s)) / sqrt(s) on [0, tan(pi/8)^2]; its relative error is
 printed. Needs python3-mpmath. Usage: scripts/fit_arctangent.py
 """
+import argparse
+
 import mpmath as mp
+
+argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter).parse_args()
 
 mp.mp.dps = 50
 s_max = mp.tan(mp.pi / 8) ** 2
