@@ -103,6 +103,15 @@ template <class T> int det_sign(T a, T b, T c, T d) {
 }
 template <class T> int cross2_sign(const Vec2<T>& a, const Vec2<T>& b) { return det_sign(a.x(), a.y(), b.x(), b.y()); }
 
+// i mod n in [0, n) for n > 0, as ((i % n) + n) % n, without the integer division where i is in [-n, 2n) (the
+// neighbours in a vertex loop): GCC emits an idiv for % by a run-time count, on each view's critical path.
+inline int wrap_index(int i, int n) {
+  if (i >= 0 && i < n) return i;
+  if (i >= n && i < 2 * n) return i - n;
+  if (i < 0 && i >= -n) return i + n;
+  return (i % n + n) % n;
+}
+
 // Normalises without overflow or underflow (scales by the largest entry first); zero stays zero.
 template <class T> Vec3<T> safe_normalized(const Vec3<T>& v) {
   const T m = max_abs(v);
@@ -159,7 +168,7 @@ template <class T> Verdict check_vertices(const PolygonLight<T>& p) {
   for (int i = 0; i < p.count; ++i)
     if (!all_finite(p.vertices[i])) return {NoSample::kNonFinite, "non-finite vertex"};
   for (int i = 0; i < p.count; ++i)
-    if (p.vertices[i] == p.vertices[(i + 1) % p.count])
+    if (p.vertices[i] == p.vertices[wrap_index(i + 1, p.count)])
       return {NoSample::kInvalidGeometry, "two consecutive vertices coincide"};
   for (int i = 0; i < p.count; ++i)
     for (int j = i + 2; j < p.count; ++j)
@@ -198,10 +207,10 @@ template <class T> bool is_spike(const Vec3<T>& a, const Vec3<T>& b, T s) {
 // with nhat and add up to one revolution. A reflex turn is forgiven only within the vertices' rounding: s is off by
 // at most |a| err_b + |b| err_a + err_a err_b.
 template <class T> Verdict check_convexity(const PolygonLight<T>& p, const Vec3<T>& nhat, T vertex_rounding) {
-  auto rounding = [&](int k) { return vertex_rounding * max_abs(p.vertices[(k + p.count) % p.count]); };
+  auto rounding = [&](int k) { return vertex_rounding * max_abs(p.vertices[wrap_index(k, p.count)]); };
   for (int i = 0; i < p.count; ++i) {
-    const Vec3<T> a = p.vertices[i] - p.vertices[(i + p.count - 1) % p.count];
-    const Vec3<T> b = p.vertices[(i + 1) % p.count] - p.vertices[i];
+    const Vec3<T> a = p.vertices[i] - p.vertices[wrap_index(i - 1, p.count)];
+    const Vec3<T> b = p.vertices[wrap_index(i + 1, p.count)] - p.vertices[i];
     if (is_spike(a, b, nhat.dot(kahan_cross<T>(a, b))))
       return {NoSample::kInvalidGeometry, "polygon is not convex (a spike)"};
   }
@@ -212,14 +221,14 @@ template <class T> Verdict check_convexity(const PolygonLight<T>& p, const Vec3<
   std::array<KeptEdge, kMaxPolygonVertices> kept;
   int nk = 0;
   for (int i = 0; i < p.count; ++i) {
-    const Vec3<T> e = p.vertices[(i + 1) % p.count] - p.vertices[i];
+    const Vec3<T> e = p.vertices[wrap_index(i + 1, p.count)] - p.vertices[i];
     KeptEdge k;
     if (edge_in_plane<T>(e, rounding(i) + rounding(i + 1), nhat, k.e, k.err)) kept[nk++] = k;
   }
   if (nk < 3) return {NoSample::kZeroSize, "fewer than three edges longer than their rounding"};
   T turning = 0;
   for (int i = 0; i < nk; ++i) {
-    const KeptEdge &ka = kept[(i + nk - 1) % nk], &kb = kept[i];
+    const KeptEdge &ka = kept[wrap_index(i - 1, nk)], &kb = kept[i];
     const T s = nhat.dot(kahan_cross<T>(ka.e, kb.e)), c = ka.e.dot(kb.e);
     const T s_err = ka.e.norm() * kb.err + kb.e.norm() * ka.err + ka.err * kb.err;
     if (s < -s_err) return {NoSample::kInvalidGeometry, "polygon is not convex"};
@@ -259,10 +268,10 @@ template <class T> NoSample check_polygon(const PolygonLight<T>& p, std::string*
 template <class T> void polygon_edges_in_plane(const PolygonLight<T>& p, const Vec3<T>& nh, T vertex_rounding,
                                                std::array<Vec3<T>, kMaxPolygonVertices>& edge,
                                                std::array<bool, kMaxPolygonVertices>& has_direction) {
-  auto rounding = [&](int k) { return vertex_rounding * max_abs(p.vertices[k % p.count]); };
+  auto rounding = [&](int k) { return vertex_rounding * max_abs(p.vertices[wrap_index(k, p.count)]); };
   for (int j = 0; j < p.count; ++j) {
     T err;
-    const Vec3<T> e = p.vertices[(j + 1) % p.count] - p.vertices[j];
+    const Vec3<T> e = p.vertices[wrap_index(j + 1, p.count)] - p.vertices[j];
     has_direction[j] = edge_in_plane<T>(e, rounding(j) + rounding(j + 1), nh, edge[j], err);
   }
 }
@@ -331,7 +340,7 @@ template <class T> LocalPolygon<T> clip_to_upper_hemisphere(const LocalPolygon<T
   LocalPolygon<T> out;
   for (int i = 0; i < in.count; ++i) {
     const Vec3<T>& p = in.v[i];
-    const Vec3<T>& q = in.v[(i + 1) % in.count];
+    const Vec3<T>& q = in.v[wrap_index(i + 1, in.count)];
     const bool p_in = p.z() >= T(0), q_in = q.z() >= T(0);
     if (p_in && out.count < kMaxClippedVertices) out.v[out.count++] = p;
     if (p_in != q_in && p.z() != T(0) && q.z() != T(0) && out.count < kMaxClippedVertices) {
@@ -500,7 +509,7 @@ inline int reference_clipped_local(const PolygonLightGeometry<long double>& g, V
   int k = 0;
   for (int i = 0; i < m; ++i) {
     const Vec3<L>& a = loc[i];
-    const Vec3<L>& b = loc[(i + 1) % m];
+    const Vec3<L>& b = loc[wrap_index(i + 1, m)];
     // A polygon convex in T up to rounding may cross the horizon more than twice in long double: no convex
     // clipped polygon, 0.
     if (a.z() >= 0) {
@@ -527,7 +536,7 @@ inline long double reference_projected_solid_angle(const PolygonLightGeometry<lo
   if (k < 3) return 0;
   L sum = 0;
   for (int j = 0; j < k; ++j) {
-    const Vec3<L> a = c[j].normalized(), b = c[(j + 1) % k].normalized();
+    const Vec3<L> a = c[j].normalized(), b = c[wrap_index(j + 1, k)].normalized();
     const Vec3<L> m = a.cross(b);
     const L s = m.norm();
     if (s == 0) continue;
@@ -573,7 +582,7 @@ template <class T> std::vector<Vec3<T>> polygon_edge_planes(const PolygonLightGe
   const int n = g.light.count;
   for (int i = 0; i < n; ++i) {
     const Vec3<T> e =
-        (g.light.vertices[i] - g.shading.position).cross(g.light.vertices[(i + 1) % n] - g.shading.position);
+        (g.light.vertices[i] - g.shading.position).cross(g.light.vertices[wrap_index(i + 1, n)] - g.shading.position);
     if (e.norm() > T(0)) planes.push_back(e.normalized());
   }
   return planes;

@@ -310,7 +310,8 @@ namespace polygon_projected_detail {
 template <class T> T azimuth_increments(const LocalPolygon<T>& p) {
   T sum = 0;
   for (int j = 0; j < p.count; ++j) {
-    const Vec2<T> a(p.v[j].x(), p.v[j].y()), b(p.v[(j + 1) % p.count].x(), p.v[(j + 1) % p.count].y());
+    const Vec2<T> a(p.v[j].x(), p.v[j].y()),
+        b(p.v[wrap_index(j + 1, p.count)].x(), p.v[wrap_index(j + 1, p.count)].y());
     sum += kernel_atan2(kahan_cross2(a, b), a.dot(b));
   }
   return sum;
@@ -342,7 +343,7 @@ template <class T> bool products_stay_normal(T c) {
 template <class T> bool winds_around_zenith(const LocalPolygon<T>& p) {
   int winding = 0;
   for (int j = 0; j < p.count; ++j) {
-    const Vec3<T>&a = p.v[j], &b = p.v[(j + 1) % p.count];
+    const Vec3<T>&a = p.v[j], &b = p.v[wrap_index(j + 1, p.count)];
     const int side = det_sign(a.x(), a.y(), b.x(), b.y());
     if (!products_stay_normal(a.x()) || !products_stay_normal(a.y()) ||
         (side == 0 && !(a.x() * b.x() + a.y() * b.y() > T(0))))
@@ -392,7 +393,7 @@ template <class T> ClippedEdges<T> classify_edges(PolygonProjectedView<T>& v) {
   ClippedEdges<T> c;
   const int m = v.clipped.count;
   for (int j = 0; j < m; ++j) {
-    v.edge_normals[j] = kahan_cross(v.clipped.v[j], v.clipped.v[(j + 1) % m]);
+    v.edge_normals[j] = kahan_cross(v.clipped.v[j], v.clipped.v[wrap_index(j + 1, m)]);
     const T nz = v.edge_normals[j].z();  // = kahan_cross2 of the xy parts: the sorting comparison
     c.sign[j] = nz > T(0) ? 1 : (nz < T(0) ? -1 : 0);
     c.any_negative = c.any_negative || c.sign[j] < 0;
@@ -405,7 +406,7 @@ template <class T> ClippedEdges<T> classify_edges(PolygonProjectedView<T>& v) {
 // The xy part of clipped vertex i (modulo the count).
 template <class T> Vec2<T> clipped_xy(const PolygonProjectedView<T>& v, int i) {
   const int m = v.clipped.count;
-  return Vec2<T>(v.clipped.v[(i % m + m) % m].x(), v.clipped.v[(i % m + m) % m].y());
+  return Vec2<T>(v.clipped.v[wrap_index(i, m)].x(), v.clipped.v[wrap_index(i, m)].y());
 }
 
 // Sec. 3.1, Fig. 3a: one sector per edge. Its sine s0 x s1 is n_{j,z} >= 0 by construction.
@@ -414,7 +415,7 @@ template <class T, bool kBiased> void central_sectors(PolygonProjectedView<T>& v
   for (int j = 0; j < m; ++j) {
     ProjectedSector<T>& s = v.sectors[v.sector_count++];
     s.s0 = clipped_xy(v, j), s.s1 = clipped_xy(v, j + 1), s.outer = edges.ell[j];
-    s.outer_a = v.clipped.v[j], s.outer_b = v.clipped.v[(j + 1) % m];
+    s.outer_a = v.clipped.v[j], s.outer_b = v.clipped.v[wrap_index(j + 1, m)];
     s.area = std::max(T(0), ellipse_sector_area<T, kBiased>(s.outer, s.s0, s.s1, v.edge_normals[j].z()));
   }
 }
@@ -427,7 +428,7 @@ bool outer_chain_ends(const PolygonProjectedView<T>& v, const ClippedEdges<T>& e
   const int m = v.clipped.count;
   auto nonzero_sign = [&](int j, int step) {
     for (int k = 1; k < m; ++k)
-      if (const int sg = edges.sign[((j + step * k) % m + m) % m]; sg != 0) return sg;
+      if (const int sg = edges.sign[wrap_index(j + step * k, m)]; sg != 0) return sg;
     return 0;
   };
   c = -1, e = -1;
@@ -435,7 +436,7 @@ bool outer_chain_ends(const PolygonProjectedView<T>& v, const ClippedEdges<T>& e
     if (edges.sign[j] <= 0) continue;
     if (nonzero_sign(j, -1) < 0 && (c < 0 || kahan_cross2(clipped_xy(v, c), clipped_xy(v, j)) < T(0))) c = j;
     if (nonzero_sign(j, 1) < 0 && (e < 0 || kahan_cross2(clipped_xy(v, e), clipped_xy(v, j + 1)) > T(0)))
-      e = (j + 1) % m;
+      e = wrap_index(j + 1, m);
   }
   return !(c < 0 || e < 0 || c == e);
 }
@@ -447,10 +448,10 @@ template <class T, bool kBiased> bool decentral_sectors(PolygonProjectedView<T>&
   int c, e;
   if (!outer_chain_ends(v, edges, c, e)) return false;
   std::array<int, kMaxClippedVertices + 1> ov{}, oe{}, iv{}, ie{};
-  const int no = (e - c + m) % m, ni = m - no;
+  const int no = wrap_index(e - c, m), ni = m - no;
   ov[0] = c, iv[0] = c;
-  for (int k = 0; k < no; ++k) oe[k] = (c + k) % m, ov[k + 1] = (c + k + 1) % m;
-  for (int k = 0; k < ni; ++k) ie[k] = (c - k - 1 + m) % m, iv[k + 1] = ie[k];
+  for (int k = 0; k < no; ++k) oe[k] = wrap_index(c + k, m), ov[k + 1] = wrap_index(c + k + 1, m);
+  for (int k = 0; k < ni; ++k) ie[k] = wrap_index(c - k - 1, m), iv[k + 1] = ie[k];
   int a = 0, bi = 0;
   Vec2<T> cur = clipped_xy(v, ov[0]);
   while (a < no && bi < ni && v.sector_count < kMaxClippedVertices) {
@@ -459,8 +460,8 @@ template <class T, bool kBiased> bool decentral_sectors(PolygonProjectedView<T>&
     ProjectedSector<T>& s = v.sectors[v.sector_count++];
     s.decentral = true;
     s.outer = edges.ell[oe[a]], s.inner = edges.ell[ie[bi]];
-    s.outer_a = v.clipped.v[oe[a]], s.outer_b = v.clipped.v[(oe[a] + 1) % m];
-    s.inner_a = v.clipped.v[ie[bi]], s.inner_b = v.clipped.v[(ie[bi] + 1) % m];
+    s.outer_a = v.clipped.v[oe[a]], s.outer_b = v.clipped.v[wrap_index(oe[a] + 1, m)];
+    s.inner_a = v.clipped.v[ie[bi]], s.inner_b = v.clipped.v[wrap_index(ie[bi] + 1, m)];
     s.s0 = cur;
     if (order > T(0))
       s.s1 = next_o, ++a;

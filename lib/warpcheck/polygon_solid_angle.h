@@ -43,7 +43,7 @@ void unclipped_fan(const PolygonLightGeometry<T>& g, const PolygonView<T>& pv, b
   f.count = m;
   const Vec3<T>& nh = pv.plane_normal;
   for (int k = 0; k < m; ++k) {
-    const int src = reverse ? (m - k) % m : k;  // keeps vertex 0 first
+    const int src = reverse ? wrap_index(m - k, m) : k;  // keeps vertex 0 first
     f.p[k] = g.light.vertices[src] - g.shading.position - pv.lift[src] * nh;
     f.e[k] = g.light.vertices[src] - g.light.vertices[0] - (pv.lift[src] - pv.lift[0]) * nh;
   }
@@ -62,7 +62,7 @@ bool clipped_fan(const PolygonView<T>& pv, bool reverse, PolygonFanView<T>& f, b
   int nq = 0, root = 0;
   const Vec3<T> light_normal = pv.frame.to_local(pv.plane_normal);
   for (int i = 0; i < c.count; ++i) {
-    const Vec3<T>&a = c.v[i], &b = c.v[(i + 1) % c.count];
+    const Vec3<T>&a = c.v[i], &b = c.v[wrap_index(i + 1, c.count)];
     q[nq++] = a;
     if (a.z() != T(0) || b.z() != T(0) || nq + (c.count - 1 - i) >= kMaxFanVertices) continue;  // room for the rest
     const Vec3<T> ua = safe_normalized(a), ub = safe_normalized(b);
@@ -72,7 +72,8 @@ bool clipped_fan(const PolygonView<T>& pv, bool reverse, PolygonFanView<T>& f, b
     if (!mid.isZero()) root = nq, q[nq++] = mid * ((a.norm() + b.norm()) / T(2)), horizon_rooted = true;
   }
   f.count = nq;
-  for (int k = 0; k < nq; ++k) f.p[k] = pv.frame.to_world(q[reverse ? (root - k + nq) % nq : (root + k) % nq]);
+  for (int k = 0; k < nq; ++k)
+    f.p[k] = pv.frame.to_world(q[reverse ? wrap_index(root - k, nq) : wrap_index(root + k, nq)]);
   for (int k = 0; k < nq; ++k) f.e[k] = f.p[k] - f.p[0];
   return true;
 }
@@ -130,7 +131,7 @@ template <class T> bool split_wide_fan_edges(PolygonFanView<T>& f, bool horizon_
   std::array<Vec3<T>, kMaxFanVertices> q;
   int nq = 0, root = -1;
   for (int k = 0; k < f.count; ++k) {
-    const int k1 = (k + 1) % f.count;
+    const int k1 = wrap_index(k + 1, f.count);
     q[nq++] = f.p[k];
     if (!(f.u[k].dot(f.u[k1]) < T(-0.5)) || nq + (f.count - 1 - k) >= kMaxFanVertices) continue;
     const Vec3<T> mid = wide_edge_midpoint(f, k, k1);
@@ -140,7 +141,7 @@ template <class T> bool split_wide_fan_edges(PolygonFanView<T>& f, bool horizon_
   }
   if (nq == f.count) return true;
   if (horizon_rooted || root < 0) root = 0;
-  for (int k = 0; k < nq; ++k) f.p[k] = q[(root + k) % nq];
+  for (int k = 0; k < nq; ++k) f.p[k] = q[wrap_index(root + k, nq)];
   f.count = nq;
   return fan_directions(f, true);
 }

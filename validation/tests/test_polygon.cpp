@@ -386,6 +386,11 @@ TEST(PolygonNumerics, KahanDetIsWithinTwoUnitsOfRoundoffOfTheExactDeterminantAnd
 }
 
 // Sec. 6.4: the approximate atan2's forward error, measured over a dense sweep of angles.
+TEST(PolygonNumerics, WrapIndexIsTheNonNegativeRemainderForEveryIndexAndCount) {
+  for (int n = 1; n <= 12; ++n)
+    for (int i = -40; i <= 40; ++i) EXPECT_EQ(wrap_index(i, n), (i % n + n) % n) << i << " mod " << n;
+}
+
 TEST(PolygonNumerics, ApproximateAtan2ForwardErrorIsBelowThePapersBound) {
   double worst = 0;
   for (int i = 0; i <= 2000000; ++i) {
