@@ -336,8 +336,9 @@ template <class T> struct LocalPolygon {
 
 // Sutherland-Hodgman against z >= 0: the crossing (q_z p - p_z q) / (q_z - p_z) does not cancel, gets z = 0 exactly,
 // and lies on the edge's great circle. A convex polygon gains at most one vertex.
-template <class T> LocalPolygon<T> clip_to_upper_hemisphere(const LocalPolygon<T>& in) {
-  LocalPolygon<T> out;
+// Written into out (not in), whose vertices beyond its new count are left as they were.
+template <class T> void clip_to_upper_hemisphere(const LocalPolygon<T>& in, LocalPolygon<T>& out) {
+  out.count = 0;
   for (int i = 0; i < in.count; ++i) {
     const Vec3<T>& p = in.v[i];
     const Vec3<T>& q = in.v[wrap_index(i + 1, in.count)];
@@ -350,6 +351,11 @@ template <class T> LocalPolygon<T> clip_to_upper_hemisphere(const LocalPolygon<T
       out.v[out.count++] = x;
     }
   }
+}
+
+template <class T> LocalPolygon<T> clip_to_upper_hemisphere(const LocalPolygon<T>& in) {
+  LocalPolygon<T> out;
+  clip_to_upper_hemisphere(in, out);
   return out;
 }
 

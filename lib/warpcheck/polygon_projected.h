@@ -494,7 +494,7 @@ NoSample fill_polygon_projected_view(const PolygonLightGeometry<T>& g, T vertex_
   v.planes = n + 1;
   if (v.flip_y)
     for (int i = 0; i < pv.local.count; ++i) pv.local.v[i].y() = -pv.local.v[i].y();
-  v.clipped = clip_to_upper_hemisphere(pv.local);
+  clip_to_upper_hemisphere(pv.local, v.clipped);  // in place: no copy
   const int m = v.clipped.count;
   bool above = false;
   for (int i = 0; i < m; ++i) above = above || v.clipped.v[i].z() > T(0);
