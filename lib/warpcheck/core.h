@@ -196,10 +196,11 @@ inline double atan2_in_double(double y, double x) {
   return std::copysign(r, y);
 }
 
-// The kernels' atan2: a float kernel's by atan2_in_double, rounded once; double's and long double's by std::atan2.
-template <class T> T kernel_atan2(T y, T x) {
+// The kernels' atan2 in scalar A for a kernel of scalar T (A = T, or double where a float kernel computes in double):
+// a float kernel's by atan2_in_double, rounded once to A; double's and long double's by std::atan2.
+template <class A, class T = A> A kernel_atan2(A y, A x) {
   if constexpr (std::is_same_v<T, float>)
-    return float(atan2_in_double(y, x));
+    return A(atan2_in_double(y, x));
   else
     return std::atan2(y, x);
 }

@@ -31,15 +31,12 @@ template <class T> T atan2_approx(T y, T x) {
   return std::signbit(y) ? -r : r;
 }
 
-// Eq. 1's arctangent in scalar A for a kernel of scalar T: the biased variant's approximation, else the kernels'
-// atan2 (kernel_atan2), for a float kernel also where it computes in double.
+// Eq. 1's arctangent in scalar A for a kernel of scalar T: the biased variant's approximation, else the kernels'.
 template <class A, bool kBiased, class T = A> A polygon_atan2(A y, A x) {
   if constexpr (kBiased)
     return atan2_approx(y, x);
-  else if constexpr (std::is_same_v<T, float>)
-    return A(atan2_in_double(y, x));
   else
-    return std::atan2(y, x);
+    return kernel_atan2<A, T>(y, x);
 }
 
 // ---- Ellipses in homogeneous form ----
@@ -310,8 +307,8 @@ namespace polygon_projected_detail {
 template <class T> T azimuth_increments(const LocalPolygon<T>& p) {
   T sum = 0;
   for (int j = 0; j < p.count; ++j) {
-    const Vec2<T> a(p.v[j].x(), p.v[j].y()),
-        b(p.v[wrap_index(j + 1, p.count)].x(), p.v[wrap_index(j + 1, p.count)].y());
+    const Vec3<T>& next = p.v[wrap_index(j + 1, p.count)];
+    const Vec2<T> a(p.v[j].x(), p.v[j].y()), b(next.x(), next.y());
     sum += kernel_atan2(kahan_cross2(a, b), a.dot(b));
   }
   return sum;
@@ -405,8 +402,8 @@ template <class T> ClippedEdges<T> classify_edges(PolygonProjectedView<T>& v) {
 
 // The xy part of clipped vertex i (modulo the count).
 template <class T> Vec2<T> clipped_xy(const PolygonProjectedView<T>& v, int i) {
-  const int m = v.clipped.count;
-  return Vec2<T>(v.clipped.v[wrap_index(i, m)].x(), v.clipped.v[wrap_index(i, m)].y());
+  const Vec3<T>& p = v.clipped.v[wrap_index(i, v.clipped.count)];
+  return Vec2<T>(p.x(), p.y());
 }
 
 // Sec. 3.1, Fig. 3a: one sector per edge. Its sine s0 x s1 is n_{j,z} >= 0 by construction.
